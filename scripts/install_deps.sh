@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Installs clothsim's build and test dependencies from Debian 12 packages only.
+# Usage: scripts/install_deps.sh   (runs apt-get through sudo when not root)
+set -euo pipefail
+packages=(
+  cmake g++ make pkg-config ninja-build
+  libeigen3-dev libsuitesparse-dev libpng-dev libosmesa6-dev libembree-dev libtbb-dev
+  libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+sudo_cmd=()
+[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+echo "install_deps: installing ${missing[*]}"
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

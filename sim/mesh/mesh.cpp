@@ -1,0 +1,28 @@
+#include "sim/mesh/mesh.hpp"
+
+#include <Eigen/Geometry>
+
+namespace clothsim {
+
+void check_triangles(const TriMesh& mesh) {
+  const int n = mesh.num_vertices();
+  if (n == 0) throw MeshError("mesh has no vertices");
+  if (mesh.triangles.empty()) throw MeshError("mesh has no triangles");
+  if (!mesh.vertices.allFinite()) throw MeshError("mesh has a non-finite vertex coordinate");
+  const double diag2 = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).squaredNorm();
+  for (int t = 0; t < mesh.num_triangles(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    const std::string name = "triangle " + std::to_string(t) + " (" + std::to_string(tri[0]) + ", " +
+                             std::to_string(tri[1]) + ", " + std::to_string(tri[2]) + ")";
+    for (int k = 0; k < 3; ++k)
+      if (tri[k] < 0 || tri[k] >= n)
+        throw MeshError(name + ": vertex index out of range (mesh has " + std::to_string(n) + " vertices)");
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
+      throw MeshError(name + " is degenerate: repeated vertex");
+    const Eigen::Vector3d e1 = mesh.vertices.row(tri[1]) - mesh.vertices.row(tri[0]);
+    const Eigen::Vector3d e2 = mesh.vertices.row(tri[2]) - mesh.vertices.row(tri[0]);
+    if (e1.cross(e2).norm() <= 1e-12 * diag2) throw MeshError(name + " is degenerate: zero area");
+  }
+}
+
+}  // namespace clothsim

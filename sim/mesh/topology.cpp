@@ -1,0 +1,107 @@
+#include "sim/mesh/topology.hpp"
+
+#include <algorithm>
+#include <map>
+#include <string>
+
+namespace clothsim {
+
+namespace {
+std::string tri_name(int t, const Triangle& tri) {
+  return "triangle " + std::to_string(t) + " (" + std::to_string(tri[0]) + ", " +
+         std::to_string(tri[1]) + ", " + std::to_string(tri[2]) + ")";
+}
+}  // namespace
+
+Topology::Topology(int num_vertices, const std::vector<Triangle>& triangles)
+    : rings_(num_vertices), boundary_(num_vertices, false), next_(num_vertices) {
+  // Undirected edge use counts and directed edge owners.
+  std::map<std::pair<int, int>, int> directed;  // (a, b) -> triangle
+  std::map<std::pair<int, int>, int> undirected_count;
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+    const Triangle& tri = triangles[t];
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3], c = tri[(k + 2) % 3];
+      if (a < 0 || a >= num_vertices)
+        throw MeshError(tri_name(t, tri) + ": vertex index out of range (mesh has " +
+                        std::to_string(num_vertices) + " vertices)");
+      if (a == b || b == c || a == c) throw MeshError(tri_name(t, tri) + " is degenerate: repeated vertex");
+      const int count = ++undirected_count[{std::min(a, b), std::max(a, b)}];
+      if (count > 2)
+        throw MeshError("non-manifold edge (" + std::to_string(std::min(a, b)) + ", " +
+                        std::to_string(std::max(a, b)) + "): shared by more than two triangles, e.g. " +
+                        tri_name(t, tri));
+      auto [it, inserted] = directed.emplace(std::make_pair(a, b), t);
+      if (!inserted)
+        throw MeshError("inconsistent orientation at edge (" + std::to_string(a) + ", " +
+                        std::to_string(b) + "): " + tri_name(it->second, triangles[it->second]) +
+                        " and " + tri_name(t, tri) + " traverse it in the same direction");
+      next_[a].emplace_back(b, c);
+    }
+  }
+  for (int v = 0; v < num_vertices; ++v) {
+    auto& pairs = next_[v];
+    if (pairs.empty()) throw MeshError("isolated vertex " + std::to_string(v) + ": it belongs to no triangle");
+    std::sort(pairs.begin(), pairs.end());
+    // A fan start is a key b that is never a value c.
+    std::vector<int> starts;
+    for (const auto& [b, c] : pairs) {
+      (void)c;
+      const bool is_value = std::any_of(pairs.begin(), pairs.end(), [b = b](const auto& p) { return p.second == b; });
+      if (!is_value) starts.push_back(b);
+    }
+    if (starts.size() > 1)
+      throw MeshError("non-manifold vertex " + std::to_string(v) +
+                      ": its triangles form more than one fan (the surface touches itself there)");
+    boundary_[v] = !starts.empty();
+    int cur = boundary_[v] ? starts.front() : pairs.front().first;
+    const int first = cur;
+    std::vector<int>& ring = rings_[v];
+    ring.push_back(cur);
+    int visited = 0;
+    while (true) {
+      auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(cur, -1));
+      if (it == pairs.end() || it->first != cur) break;  // reached the end of a boundary fan
+      ++visited;
+      cur = it->second;
+      if (cur == first) break;  // closed fan
+      ring.push_back(cur);
+      if (visited > static_cast<int>(pairs.size())) break;
+    }
+    if (visited != static_cast<int>(pairs.size()))
+      throw MeshError("non-manifold vertex " + std::to_string(v) +
+                      ": its triangles form more than one fan (the surface touches itself there)");
+  }
+  // Boundary loops: from a boundary vertex, the boundary edge leaving it goes to ring.front().
+  std::vector<bool> seen(num_vertices, false);
+  for (int v = 0; v < num_vertices; ++v) {
+    if (!boundary_[v] || seen[v]) continue;
+    std::vector<int> loop;
+    int cur = v;
+    while (!seen[cur]) {
+      seen[cur] = true;
+      loop.push_back(cur);
+      cur = rings_[cur].front();
+    }
+    loops_.push_back(std::move(loop));
+  }
+}
+
+int Topology::opposite(int a, int b) const {
+  const auto& pairs = next_[a];
+  auto it = std::lower_bound(pairs.begin(), pairs.end(), std::make_pair(b, -1));
+  if (it == pairs.end() || it->first != b) return -1;
+  return it->second;
+}
+
+std::vector<int> Topology::ring_from(int v, int first) const {
+  const auto& ring = rings_[v];
+  auto it = std::find(ring.begin(), ring.end(), first);
+  if (it == ring.end())
+    throw MeshError("vertex " + std::to_string(first) + " is not a neighbour of vertex " + std::to_string(v));
+  std::vector<int> out(it, ring.end());
+  out.insert(out.end(), ring.begin(), it);
+  return out;
+}
+
+}  // namespace clothsim

@@ -1,0 +1,68 @@
+// Linear static analysis of a Kirchhoff–Love subdivision shell (Cirak et al. 2000; paper §4.2
+// eq. 25, K u = f): assemble, apply boundary conditions, solve with CHOLMOD.
+#pragma once
+
+#include "sim/mesh/mesh.hpp"
+#include "sim/shell/material.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+enum class Quadrature {
+  one_point,    // barycentre, weight 1/2 (the paper's and Cirak's choice)
+  three_point,  // degree 2, interior points (1/6, 1/6), (2/3, 1/6), (1/6, 2/3)
+  six_point,    // degree 4 (Dunavant)
+};
+
+// Boundary condition on a set of control vertices (paper §4.4, formulas.md §6).
+struct BoundaryCondition {
+  std::vector<int> vertices;                   // selected control vertices
+  std::array<bool, 3> fix{true, true, true};   // displacement components held at zero (x, y, z)
+  bool clamped = false;                        // false: hinged (rotation free); true: slope held
+                                               // across border edges whose two ends are selected
+};
+
+// A force applied at the limit point of a control vertex, spread with the limit-mask weights.
+struct PointLoad {
+  int vertex = 0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();  // [N]
+};
+
+struct StaticProblem {
+  TriMesh mesh;  // control mesh (already refined so that no triangle has two irregular vertices)
+  ShellMaterial material;
+  std::vector<BoundaryCondition> boundary;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();       // [m/s²], mass-proportional load
+  Eigen::Vector3d surface_load = Eigen::Vector3d::Zero();  // [N/m² of reference area]
+  std::vector<PointLoad> point_loads;
+  Quadrature quadrature = Quadrature::one_point;
+};
+
+struct StaticResult {
+  Eigen::MatrixX3d displacement;        // #V × 3 control-vertex displacements [m]
+  Eigen::MatrixX3d limit_rest;          // #V × 3 rest positions of the vertices' limit points [m]
+  Eigen::MatrixX3d limit_displacement;  // #V × 3 displacement of those limit points [m]
+  int dofs = 0;                         // free degrees of freedom
+  double assemble_seconds = 0.0;        // element matrices, assembly and loads [s]
+  double solve_seconds = 0.0;           // factorisation and solve [s]
+};
+
+// Throws std::runtime_error (MeshError for mesh problems) with a message naming the problem,
+// e.g. an unsupported structure (singular stiffness) or a non-finite solution.
+StaticResult solve_static(const StaticProblem& problem);
+
+// Messages for the user's log (one line each, no newline).
+using LogFn = std::function<void(const std::string&)>;
+
+// Returns `mesh`, refined once by Loop subdivision (crease rules on borders, corners kept) if any
+// triangle has more than one irregular vertex (valence ≠ 6, counting the ghost layer at borders);
+// logs what it did. Throws MeshError for invalid meshes (naming the element).
+TriMesh prepare_control_mesh(const TriMesh& mesh, const LogFn& log);
+
+}  // namespace clothsim
