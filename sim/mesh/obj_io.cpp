@@ -1,0 +1,223 @@
+// Wavefront OBJ reading (with line-numbered errors and mesh validation) and exact-precision
+// writing.
+#include "sim/mesh/obj_io.hpp"
+
+#include "sim/mesh/topology.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <stdexcept>
+#include <string_view>
+#include <system_error>
+#include <utility>
+
+namespace clothsim {
+
+namespace {
+
+// Splits a line into whitespace-separated tokens.
+std::vector<std::string_view> tokenize(std::string_view line) {
+  std::vector<std::string_view> tokens;
+  std::size_t pos = 0;
+  while (pos < line.size()) {
+    while (pos < line.size() && (line[pos] == ' ' || line[pos] == '\t' || line[pos] == '\v' || line[pos] == '\f'))
+      ++pos;
+    if (pos >= line.size()) break;
+    const std::size_t start = pos;
+    while (pos < line.size() && line[pos] != ' ' && line[pos] != '\t' && line[pos] != '\v' && line[pos] != '\f')
+      ++pos;
+    tokens.push_back(line.substr(start, pos - start));
+  }
+  return tokens;
+}
+
+// Parses the whole token as a double (an optional leading '+' is accepted).
+bool parse_double(std::string_view token, double& value) {
+  if (!token.empty() && token.front() == '+') {
+    token.remove_prefix(1);
+    if (!token.empty() && token.front() == '-') return false;
+  }
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  return !token.empty() && ec == std::errc() && ptr == end;
+}
+
+// Parses the whole token as an integer.
+bool parse_integer(std::string_view token, long long& value) {
+  if (token.empty()) return false;
+  const char* end = token.data() + token.size();
+  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+  return ec == std::errc() && ptr == end;
+}
+
+struct FaceCorner {
+  long long index;    // 0-based; a positive file index is range-checked once all vertices are read
+  long long written;  // the index as written in the file, for error messages
+};
+
+struct PendingTriangle {
+  std::array<FaceCorner, 3> corners;
+  long long line;
+};
+
+[[noreturn]] void fail(const std::string& path, long long line, const std::string& message) {
+  throw MeshError(path + ":" + std::to_string(line) + ": " + message);
+}
+
+}  // namespace
+
+TriMesh read_obj(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw MeshError(path + ": cannot open file");
+
+  std::vector<std::array<double, 3>> positions;
+  std::vector<PendingTriangle> pending;
+  std::string text;
+  long long line_number = 0;
+  while (std::getline(in, text)) {
+    ++line_number;
+    std::string_view line(text);
+    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    const std::vector<std::string_view> tokens = tokenize(line);
+    if (tokens.empty()) continue;
+
+    if (tokens[0] == "v") {
+      // x y z, optionally followed by w or by an r g b colour; only x y z are used.
+      const std::size_t count = tokens.size() - 1;
+      if (count != 3 && count != 4 && count != 6 && count != 7) fail(path, line_number, "malformed vertex line");
+      std::array<double, 3> p{};
+      for (std::size_t k = 1; k < tokens.size(); ++k) {
+        double value = 0.0;
+        if (!parse_double(tokens[k], value)) fail(path, line_number, "malformed vertex line");
+        if (k <= 3) {
+          if (!std::isfinite(value))
+            fail(path, line_number, "non-finite vertex coordinate '" + std::string(tokens[k]) + "'");
+          p[k - 1] = value;
+        }
+      }
+      positions.push_back(p);
+    } else if (tokens[0] == "f") {
+      if (tokens.size() < 4)
+        fail(path, line_number, "malformed face line: a face needs at least 3 vertices, found " +
+                              std::to_string(tokens.size() - 1));
+      std::vector<FaceCorner> corners;
+      corners.reserve(tokens.size() - 1);
+      for (std::size_t k = 1; k < tokens.size(); ++k) {
+        const std::string_view entry = tokens[k];
+        // Forms: i, i/t, i//n, i/t/n. Only i is used, but t and n must be integers if present.
+        long long index = 0;
+        long long ignored = 0;
+        const std::size_t slash = entry.find('/');
+        bool well_formed = parse_integer(entry.substr(0, slash), index);
+        if (well_formed && slash != std::string_view::npos) {
+          const std::string_view rest = entry.substr(slash + 1);
+          const std::size_t second = rest.find('/');
+          if (second == std::string_view::npos) {
+            well_formed = parse_integer(rest, ignored);  // i/t
+          } else {
+            const std::string_view texture = rest.substr(0, second);  // empty in i//n
+            well_formed = (texture.empty() || parse_integer(texture, ignored)) &&
+                          parse_integer(rest.substr(second + 1), ignored);
+          }
+        }
+        if (!well_formed) fail(path, line_number, "malformed face entry '" + std::string(entry) + "'");
+        if (index == 0) fail(path, line_number, "face index 0 is invalid (OBJ indices start at 1)");
+        if (index < 0) {
+          // Relative to the vertices defined so far: -1 is the most recent one.
+          const long long resolved = static_cast<long long>(positions.size()) + index;
+          if (resolved < 0)
+            fail(path, line_number, "face index " + std::to_string(index) + " out of range (only " +
+                                  std::to_string(positions.size()) + " vertices defined before this line)");
+          corners.push_back({resolved, index});
+        } else {
+          corners.push_back({index - 1, index});
+        }
+      }
+      // Fan triangulation around the first corner.
+      for (std::size_t k = 1; k + 1 < corners.size(); ++k)
+        pending.push_back({{corners[0], corners[k], corners[k + 1]}, line_number});
+    }
+    // Everything else (vn, vt, vp, o, g, s, l, usemtl, mtllib, ...) is ignored.
+  }
+  if (in.bad()) throw MeshError(path + ": read error");
+
+  const long long num_vertices = static_cast<long long>(positions.size());
+  if (pending.empty()) throw MeshError(path + ": file has no faces");
+  for (const PendingTriangle& tri : pending)
+    for (const FaceCorner& corner : tri.corners)
+      if (corner.index >= num_vertices)
+        fail(path, tri.line, "face index " + std::to_string(corner.written) + " out of range (file has " +
+                                 std::to_string(num_vertices) + " vertices)");
+  if (num_vertices > std::numeric_limits<int>::max()) throw MeshError(path + ": too many vertices");
+
+  TriMesh mesh;
+  mesh.vertices.resize(static_cast<Eigen::Index>(positions.size()), 3);
+  for (std::size_t v = 0; v < positions.size(); ++v)
+    for (int k = 0; k < 3; ++k) mesh.vertices(static_cast<Eigen::Index>(v), k) = positions[v][static_cast<std::size_t>(k)];
+  mesh.triangles.reserve(pending.size());
+  for (const PendingTriangle& tri : pending)
+    mesh.triangles.push_back({static_cast<int>(tri.corners[0].index), static_cast<int>(tri.corners[1].index),
+                              static_cast<int>(tri.corners[2].index)});
+
+  try {
+    check_triangles(mesh);
+    const Topology topology(mesh.num_vertices(), mesh.triangles);
+    (void)topology;
+  } catch (const MeshError& e) {
+    throw MeshError(path + ": " + e.what());
+  }
+  return mesh;
+}
+
+void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices, const std::vector<Triangle>& triangles,
+               const std::string& comment) {
+  const Eigen::Index n = vertices.rows();
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (const int v : triangles[t])
+      if (v < 0 || v >= n)
+        throw MeshError("cannot write '" + path + "': triangle " + std::to_string(t) + " has vertex index " +
+                        std::to_string(v) + " out of range (mesh has " + std::to_string(n) + " vertices)");
+
+  std::ofstream out(path, std::ios::out | std::ios::trunc);
+  if (!out) throw std::runtime_error("cannot open '" + path + "' for writing");
+
+  if (!comment.empty()) {
+    std::size_t start = 0;
+    while (start <= comment.size()) {
+      std::size_t end = comment.find('\n', start);
+      if (end == std::string::npos) end = comment.size();
+      std::string_view line(comment.data() + start, end - start);
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      out << "# " << line << '\n';
+      if (end == comment.size()) break;
+      start = end + 1;
+    }
+  }
+
+  // Shortest representation that parses back to the same double (round-trip exact).
+  std::array<char, 64> buffer{};
+  auto put = [&out, &buffer](double value) {
+    const auto [ptr, ec] = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+    (void)ec;  // cannot fail: 64 characters hold any double
+    out.write(buffer.data(), ptr - buffer.data());
+  };
+  for (Eigen::Index v = 0; v < n; ++v) {
+    out << "v ";
+    put(vertices(v, 0));
+    out << ' ';
+    put(vertices(v, 1));
+    out << ' ';
+    put(vertices(v, 2));
+    out << '\n';
+  }
+  for (const Triangle& tri : triangles) out << "f " << tri[0] + 1 << ' ' << tri[1] + 1 << ' ' << tri[2] + 1 << '\n';
+
+  out.close();
+  if (!out) throw std::runtime_error("error while writing '" + path + "'");
+}
+
+}  // namespace clothsim

@@ -1,0 +1,34 @@
+// Reading and writing triangle meshes in the Wavefront OBJ format (geometry only: vertex
+// positions and faces; normals, texture coordinates, groups and materials are ignored).
+#pragma once
+
+#include "sim/mesh/mesh.hpp"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+// Reads the `v x y z` and `f ...` lines of an OBJ file. Face entries may be `i`, `i/t`, `i//n`
+// or `i/t/n`, with 1-based or negative (relative to the vertices read so far) indices; polygons
+// with more than three corners are fan-triangulated as (c0, ck, ck+1). All other line types are
+// ignored. Positions are taken as metres [m].
+//
+// Throws MeshError naming the file and, for parse errors, the line ("mesh.obj:12: face index
+// 40 out of range (file has 10 vertices)"). The parsed mesh is then validated with
+// check_triangles and Topology (degenerate triangles, non-manifold edges or vertices,
+// inconsistent orientation, isolated vertices); those errors are rethrown prefixed with
+// "<path>: ".
+TriMesh read_obj(const std::string& path);
+
+// Writes `vertices` [m] and `triangles` (0-based, written 1-based) to an OBJ file, with every
+// coordinate printed in the shortest form that reads back to the identical double. A non-empty
+// `comment` is written as a leading `# comment` line (each line of a multi-line comment gets its
+// own `#`). Throws MeshError (before touching the file) if a triangle has an out-of-range index,
+// and std::runtime_error naming the path if the file cannot be written.
+void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices,
+               const std::vector<Triangle>& triangles, const std::string& comment = "");
+
+}  // namespace clothsim
