@@ -3,7 +3,9 @@
 #pragma once
 
 #include "sim/mesh/mesh.hpp"
+#include "sim/shell/boundary_condition.hpp"
 #include "sim/shell/material.hpp"
+#include "sim/shell/quadrature.hpp"
 
 #include <Eigen/Core>
 
@@ -13,20 +15,6 @@
 #include <vector>
 
 namespace clothsim {
-
-enum class Quadrature {
-  one_point,    // barycentre, weight 1/2 (the paper's and Cirak's choice)
-  three_point,  // degree 2, interior points (1/6, 1/6), (2/3, 1/6), (1/6, 2/3)
-  six_point,    // degree 4 (Dunavant)
-};
-
-// Boundary condition on a set of control vertices (paper §4.4, formulas.md §6).
-struct BoundaryCondition {
-  std::vector<int> vertices;                   // selected control vertices
-  std::array<bool, 3> fix{true, true, true};   // displacement components held at zero (x, y, z)
-  bool clamped = false;                        // false: hinged (rotation free); true: slope held
-                                               // across border edges whose two ends are selected
-};
 
 // A force applied at the limit point of a control vertex, spread with the limit-mask weights.
 struct PointLoad {

@@ -1,0 +1,16 @@
+// Boundary conditions on control vertices (paper §4.4, formulas.md §6).
+#pragma once
+
+#include <array>
+#include <vector>
+
+namespace clothsim {
+
+struct BoundaryCondition {
+  std::vector<int> vertices;                  // selected control vertices
+  std::array<bool, 3> fix{true, true, true};  // displacement components held at zero (x, y, z)
+  bool clamped = false;                       // false: hinged (rotation free); true: slope held
+                                              // across border edges whose two ends are selected
+};
+
+}  // namespace clothsim

@@ -1,0 +1,91 @@
+#include "sim/shell/element.hpp"
+
+#include "sim/subdivision/box_spline.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+namespace clothsim {
+
+SurfacePoint surface_point(const BasisMatrix& basis, const Eigen::MatrixX3d& x) {
+  SurfacePoint s;
+  s.a1 = (basis.row(kDv) * x).transpose();
+  s.a2 = (basis.row(kDw) * x).transpose();
+  s.a11 = (basis.row(kDvv) * x).transpose();
+  s.a12 = (basis.row(kDvw) * x).transpose();
+  s.a22 = (basis.row(kDww) * x).transpose();
+  const Eigen::Vector3d n = s.a1.cross(s.a2);
+  s.j = n.norm();
+  s.a3 = n / s.j;
+  return s;
+}
+
+Eigen::Matrix3d material_matrix(const SurfacePoint& s, double nu) {
+  Eigen::Matrix2d metric;
+  metric << s.a1.dot(s.a1), s.a1.dot(s.a2), s.a1.dot(s.a2), s.a2.dot(s.a2);
+  const Eigen::Matrix2d inv = metric.inverse();
+  const double c11 = inv(0, 0), c22 = inv(1, 1), c12 = inv(0, 1);
+  Eigen::Matrix3d h;
+  h << c11 * c11, nu * c11 * c22 + (1 - nu) * c12 * c12, c11 * c12,  //
+      0, c22 * c22, c22 * c12,                                       //
+      0, 0, 0.5 * ((1 - nu) * c11 * c22 + (1 + nu) * c12 * c12);
+  h(1, 0) = h(0, 1);
+  h(2, 0) = h(0, 2);
+  h(2, 1) = h(1, 2);
+  return h;
+}
+
+void strain_matrices(const BasisMatrix& basis, const SurfacePoint& s, StrainMatrix& membrane, StrainMatrix& bending) {
+  const Eigen::Index n = basis.cols();
+  membrane.resize(3, 3 * n);
+  bending.resize(3, 3 * n);
+  const double inv_j = 1.0 / s.j;
+  const Eigen::Vector3d a2xa3 = s.a2.cross(s.a3), a3xa1 = s.a3.cross(s.a1);
+  const Eigen::Vector3d* second[3] = {&s.a11, &s.a22, &s.a12};
+  const int row_of[3] = {kDvv, kDww, kDvw};
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double n1 = basis(kDv, i), n2 = basis(kDw, i);
+    membrane.block<1, 3>(0, 3 * i) = n1 * s.a1.transpose();
+    membrane.block<1, 3>(1, 3 * i) = n2 * s.a2.transpose();
+    membrane.block<1, 3>(2, 3 * i) = (n2 * s.a1 + n1 * s.a2).transpose();
+    for (int r = 0; r < 3; ++r) {
+      const Eigen::Vector3d& aab = *second[r];
+      const Eigen::Vector3d row = -basis(row_of[r], i) * s.a3 +
+                                  inv_j * (n1 * aab.cross(s.a2) + n2 * s.a1.cross(aab)) +
+                                  (s.a3.dot(aab) * inv_j) * (n1 * a2xa3 + n2 * a3xa1);
+      bending.block<1, 3>(r, 3 * i) = (r == 2 ? 2.0 : 1.0) * row.transpose();
+    }
+  }
+}
+
+Eigen::Matrix<double, 6, 1> nonlinear_strains(const BasisMatrix& basis, const Eigen::MatrixX3d& rest,
+                                              const Eigen::MatrixX3d& deformed) {
+  const SurfacePoint r = surface_point(basis, rest), d = surface_point(basis, deformed);
+  Eigen::Matrix<double, 6, 1> e;
+  e(0) = 0.5 * (d.a1.dot(d.a1) - r.a1.dot(r.a1));
+  e(1) = 0.5 * (d.a2.dot(d.a2) - r.a2.dot(r.a2));
+  e(2) = d.a1.dot(d.a2) - r.a1.dot(r.a2);
+  e(3) = r.a11.dot(r.a3) - d.a11.dot(d.a3);
+  e(4) = r.a22.dot(r.a3) - d.a22.dot(d.a3);
+  e(5) = 2.0 * (r.a12.dot(r.a3) - d.a12.dot(d.a3));
+  return e;
+}
+
+void add_element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
+                           const Eigen::MatrixX3d& rest, const ShellMaterial& material, Eigen::MatrixXd& k) {
+  const Eigen::Index dofs = 3 * rest.rows();
+  if (k.size() == 0) k = Eigen::MatrixXd::Zero(dofs, dofs);
+  StrainMatrix m, b;
+  for (size_t q = 0; q < basis.size(); ++q) {
+    const SurfacePoint s = surface_point(basis[q], rest);
+    const Eigen::Matrix3d h = material_matrix(s, material.poisson_ratio);
+    strain_matrices(basis[q], s, m, b);
+    const double scale = weights[q] * s.j;
+    const Eigen::Matrix3d hm = (scale * material.membrane_stiffness()) * h;
+    const Eigen::Matrix3d hb = (scale * material.bending_stiffness()) * h;
+    k.noalias() += m.transpose() * (hm * m);
+    k.noalias() += b.transpose() * (hb * b);
+  }
+}
+
+}  // namespace clothsim

@@ -1,0 +1,46 @@
+// The linear Kirchhoff–Love subdivision shell element (Cirak et al. 2000 eqs. 21–22; paper
+// §4.2 eqs. 24–27; formulas.md §4–5).
+//
+// At a point of an element with patch vertices I = 0 .. n−1 (basis rows from patch.hpp) and
+// rest positions X_I, the linearised membrane and bending strains in Voigt order
+// [ε₁₁, ε₂₂, 2ε₁₂] are α = Σ M_I u_I and β = Σ B_I u_I (local DOF order [x0 y0 z0 x1 y1 z1 ...]).
+// The element stiffness is K_e = Σ_q w_q j (K_m Mᵀ H M + D_b Bᵀ H B), with H the isotropic
+// material matrix in the curvilinear frame, K_m = E t/(1 − ν²), D_b = E t³/(12(1 − ν²)).
+#pragma once
+
+#include "sim/shell/material.hpp"
+
+#include <Eigen/Core>
+
+namespace clothsim {
+
+using BasisMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // rows: BasisRow of box_spline.hpp
+using StrainMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;  // 3 × 3n
+
+// Geometry of the reference surface at one point.
+struct SurfacePoint {
+  Eigen::Vector3d a1, a2, a3;     // covariant tangents and unit normal
+  Eigen::Vector3d a11, a12, a22;  // second derivatives of the position
+  double j = 0.0;                 // area element |a1 × a2| (dA = j dθ¹ dθ²)
+};
+
+SurfacePoint surface_point(const BasisMatrix& basis, const Eigen::MatrixX3d& x);
+
+// Isotropic constitutive matrix in Voigt form in the curvilinear frame (formulas.md §5).
+Eigen::Matrix3d material_matrix(const SurfacePoint& s, double poisson_ratio);
+
+// Strain–displacement matrices (3 × 3n) of the linearised membrane and bending strains.
+void strain_matrices(const BasisMatrix& basis, const SurfacePoint& s, StrainMatrix& membrane, StrainMatrix& bending);
+
+// Exact (nonlinear) membrane and bending strains of the deformed positions x relative to the
+// rest positions X, [α₁₁, α₂₂, 2α₁₂, β₁₁, β₂₂, 2β₁₂] with α_αβ = ½(a_α·a_β − A_α·A_β) and
+// β_αβ = A_αβ·A₃ − a_αβ·a₃. Their derivative at x = X is the linear strain: used to test it.
+Eigen::Matrix<double, 6, 1> nonlinear_strains(const BasisMatrix& basis, const Eigen::MatrixX3d& rest,
+                                              const Eigen::MatrixX3d& deformed);
+
+// Adds Σ_q weight_q · j (K_m Mᵀ H M + D_b Bᵀ H B) for the given quadrature points to `k`
+// (3n × 3n, resized and zeroed when empty).
+void add_element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
+                           const Eigen::MatrixX3d& rest, const ShellMaterial& material, Eigen::MatrixXd& k);
+
+}  // namespace clothsim

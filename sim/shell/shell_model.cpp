@@ -1,0 +1,182 @@
+#include "sim/shell/shell_model.hpp"
+
+#include "sim/subdivision/loop.hpp"
+#include "sim/subdivision/patch.hpp"
+
+#include <algorithm>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+namespace clothsim {
+
+namespace {
+
+ShellElement make_element(const ExtendedMesh& ext, const DofMap& dofs, const Triangle& tri,
+                          const std::vector<QuadraturePoint>& rule) {
+  ShellElement el;
+  el.triangle = tri;
+  for (const QuadraturePoint& q : rule) {
+    PatchEvaluation pe = evaluate_patch(ext.topology, tri, q.v, q.w);
+    if (el.patch.empty()) el.patch = pe.vertices;
+    if (pe.vertices != el.patch) throw std::logic_error("element patch changed between quadrature points");
+    el.basis.push_back(std::move(pe.basis));
+    el.weights.push_back(q.weight);
+  }
+  el.identity = std::all_of(el.patch.begin(), el.patch.end(), [&](int v) { return dofs.is_identity(v); });
+  if (el.identity) {
+    el.real = el.patch;
+    return el;
+  }
+  for (int p : el.patch)
+    for (int c = 0; c < 3; ++c)
+      for (const auto& [r, w] : dofs.combination(p, c)) {
+        (void)w;
+        el.real.push_back(r);
+      }
+  std::sort(el.real.begin(), el.real.end());
+  el.real.erase(std::unique(el.real.begin(), el.real.end()), el.real.end());
+  std::map<int, Eigen::Index> col;
+  for (size_t i = 0; i < el.real.size(); ++i) col[el.real[i]] = static_cast<Eigen::Index>(i);
+  const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size()), nr = static_cast<Eigen::Index>(el.real.size());
+  for (int c = 0; c < 3; ++c) {
+    el.fold[c] = Eigen::MatrixXd::Zero(np, nr);
+    for (Eigen::Index p = 0; p < np; ++p)
+      for (const auto& [r, w] : dofs.combination(el.patch[p], c)) el.fold[c](p, col.at(r)) += w;
+  }
+  return el;
+}
+
+Eigen::MatrixX3d patch_rows(const Eigen::MatrixX3d& x, const std::vector<int>& ids) {
+  Eigen::MatrixX3d out(static_cast<Eigen::Index>(ids.size()), 3);
+  for (size_t i = 0; i < ids.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = x.row(ids[i]);
+  return out;
+}
+
+}  // namespace
+
+ShellModel::ShellModel(const TriMesh& mesh, const ShellMaterial& material,
+                       const std::vector<BoundaryCondition>& conditions, Quadrature quadrature)
+    : ext_(build_ghost_layer(mesh)), dofs_(ext_, conditions), material_(material) {
+  const std::vector<QuadraturePoint> rule = quadrature_points(quadrature);
+  elements_.reserve(mesh.triangles.size());
+  for (int t = 0; t < mesh.num_triangles(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    if (irregular_vertex_count(ext_, tri) > 1)
+      throw MeshError("triangle " + std::to_string(t) + " has more than one irregular vertex; refine the mesh first");
+    elements_.push_back(make_element(ext_, dofs_, tri, rule));
+  }
+}
+
+Eigen::MatrixXd ShellModel::folded_element_stiffness(int e) const {
+  const ShellElement& el = elements_[e];
+  Eigen::MatrixXd k;
+  add_element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, k);
+  if (el.identity) return k;
+  const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size()), nr = static_cast<Eigen::Index>(el.real.size());
+  Eigen::MatrixXd t = Eigen::MatrixXd::Zero(3 * np, 3 * nr);
+  for (int c = 0; c < 3; ++c)
+    for (Eigen::Index p = 0; p < np; ++p)
+      for (Eigen::Index r = 0; r < nr; ++r) t(3 * p + c, 3 * r + c) = el.fold[c](p, r);
+  return t.transpose() * k * t;
+}
+
+Eigen::SparseMatrix<double> ShellModel::stiffness() const {
+  const int n = num_vertices();
+  // Block pattern: column block j holds row blocks nb[j] (sorted), each 3 × 3 dense.
+  std::vector<std::vector<int>> nb(n);
+  for (int v = 0; v < n; ++v) nb[v].push_back(v);
+  for (const ShellElement& el : elements_)
+    for (int j : el.real) nb[j].insert(nb[j].end(), el.real.begin(), el.real.end());
+  for (auto& list : nb) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  std::vector<Eigen::Index> column_start(3 * n + 1, 0);
+  for (int j = 0; j < n; ++j)
+    for (int d = 0; d < 3; ++d) column_start[3 * j + d + 1] = column_start[3 * j + d] + 3 * static_cast<Eigen::Index>(nb[j].size());
+  const Eigen::Index nnz = column_start[3 * n];
+  Eigen::SparseMatrix<double> k(3 * n, 3 * n);
+  k.makeCompressed();
+  k.resizeNonZeros(nnz);
+  for (Eigen::Index c = 0; c <= 3 * n; ++c) k.outerIndexPtr()[c] = static_cast<int>(column_start[c]);
+  for (int j = 0; j < n; ++j)
+    for (int d = 0; d < 3; ++d) {
+      Eigen::Index pos = column_start[3 * j + d];
+      for (int i : nb[j])
+        for (int c = 0; c < 3; ++c) k.innerIndexPtr()[pos++] = 3 * i + c;
+    }
+  std::fill(k.valuePtr(), k.valuePtr() + nnz, 0.0);
+
+  std::vector<Eigen::Index> local_index;
+  for (int e = 0; e < static_cast<int>(elements_.size()); ++e) {
+    const ShellElement& el = elements_[e];
+    const Eigen::MatrixXd ke = folded_element_stiffness(e);
+    const Eigen::Index m = static_cast<Eigen::Index>(el.real.size());
+    for (Eigen::Index b = 0; b < m; ++b) {
+      const int j = el.real[b];
+      const std::vector<int>& list = nb[j];
+      const Eigen::Index stride = 3 * static_cast<Eigen::Index>(list.size());
+      for (Eigen::Index a = 0; a < m; ++a) {
+        const Eigen::Index slot = std::lower_bound(list.begin(), list.end(), el.real[a]) - list.begin();
+        const Eigen::Index base = column_start[3 * j] + 3 * slot;
+        for (int d = 0; d < 3; ++d)
+          for (int c = 0; c < 3; ++c) k.valuePtr()[base + d * stride + c] += ke(3 * a + c, 3 * b + d);
+      }
+    }
+  }
+  for (int v = 0; v < n; ++v)
+    for (int c = 0; c < 3; ++c)
+      if (!dofs_.is_free(v, c)) k.coeffRef(3 * v + c, 3 * v + c) = 1.0;
+  return k;
+}
+
+void ShellModel::scatter_vector(const ShellElement& el, const Eigen::VectorXd& local, Eigen::VectorXd& global) const {
+  for (size_t p = 0; p < el.patch.size(); ++p)
+    for (int c = 0; c < 3; ++c)
+      for (const auto& [r, w] : dofs_.combination(el.patch[p], c)) global(3 * r + c) += w * local(3 * static_cast<Eigen::Index>(p) + c);
+}
+
+Eigen::VectorXd ShellModel::area_load(const Eigen::Vector3d& q) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * num_vertices());
+  for (const ShellElement& el : elements_) {
+    const Eigen::MatrixX3d x = patch_rows(ext_.rest, el.patch);
+    Eigen::VectorXd local = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(el.patch.size()));
+    for (size_t k = 0; k < el.basis.size(); ++k) {
+      const double scale = el.weights[k] * surface_point(el.basis[k], x).j;
+      for (Eigen::Index p = 0; p < static_cast<Eigen::Index>(el.patch.size()); ++p)
+        local.segment<3>(3 * p) += scale * el.basis[k](kValue, p) * q;
+    }
+    scatter_vector(el, local, f);
+  }
+  return f;
+}
+
+Eigen::VectorXd ShellModel::point_load(int v, const Eigen::Vector3d& force) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * num_vertices());
+  const std::vector<int>& ring = ext_.topology.ring(v);
+  const int valence = static_cast<int>(ring.size());
+  const double w = limit_neighbour_weight(valence);
+  auto add = [&](int vertex, double weight) {
+    for (int c = 0; c < 3; ++c)
+      for (const auto& [r, cw] : dofs_.combination(vertex, c)) f(3 * r + c) += weight * cw * force(c);
+  };
+  add(v, 1.0 - valence * w);
+  for (int r : ring) add(r, w);
+  return f;
+}
+
+Eigen::MatrixX3d ShellModel::limit_points(const Eigen::MatrixX3d& x) const {
+  Eigen::MatrixX3d out(num_vertices(), 3);
+  for (int v = 0; v < num_vertices(); ++v) {
+    const std::vector<int>& ring = ext_.topology.ring(v);
+    const int valence = static_cast<int>(ring.size());
+    const double w = limit_neighbour_weight(valence);
+    Eigen::RowVector3d p = (1.0 - valence * w) * x.row(v);
+    for (int r : ring) p += w * x.row(r);
+    out.row(v) = p;
+  }
+  return out;
+}
+
+}  // namespace clothsim

@@ -1,0 +1,71 @@
+// A Kirchhoff–Love subdivision shell on a control mesh: the ghost layer, the boundary
+// conditions folded into each element, per-element basis data at the quadrature points, the
+// rest-state element stiffness, and sparse assembly over the real vertices (paper eqs. 26–27).
+//
+// Global vectors are flat over the real control vertices, [x0 y0 z0 x1 ...] (3·#V); matrices are
+// 3·#V square. Components that are not free (fixed, or tied by a clamped border) have no
+// coupling: their rows and columns hold only a unit diagonal, and their load entries are zero.
+#pragma once
+
+#include "sim/mesh/mesh.hpp"
+#include "sim/shell/boundary_condition.hpp"
+#include "sim/shell/dof_map.hpp"
+#include "sim/shell/element.hpp"
+#include "sim/shell/ghost_layer.hpp"
+#include "sim/shell/material.hpp"
+#include "sim/shell/quadrature.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <vector>
+
+namespace clothsim {
+
+struct ShellElement {
+  Triangle triangle;                // real vertices (a, b, c)
+  std::vector<int> patch;           // extended-mesh control vertices of the patch
+  std::vector<BasisMatrix> basis;   // per quadrature point, columns as `patch`
+  std::vector<double> weights;      // quadrature weights (sum 1/2)
+  std::vector<int> real;            // real vertices the patch's displacements depend on
+  bool identity = false;            // patch == real and every component free and itself
+  std::array<Eigen::MatrixXd, 3> fold;  // per component: #patch × #real weights (when !identity)
+};
+
+class ShellModel {
+ public:
+  ShellModel(const TriMesh& mesh, const ShellMaterial& material, const std::vector<BoundaryCondition>& conditions,
+             Quadrature quadrature);
+
+  int num_vertices() const { return ext_.num_real; }
+  const ExtendedMesh& extended() const { return ext_; }
+  const DofMap& dofs() const { return dofs_; }
+  const std::vector<ShellElement>& elements() const { return elements_; }
+  const ShellMaterial& material() const { return material_; }
+
+  // Rest-state stiffness over the real vertices (3·#V square, symmetric).
+  Eigen::SparseMatrix<double> stiffness() const;
+  // Element stiffness folded onto the element's real vertices (3·#real square).
+  Eigen::MatrixXd folded_element_stiffness(int e) const;
+
+  // Consistent load of a force per unit reference area q [N/m²]: f_I = ∫ N_I q dA.
+  Eigen::VectorXd area_load(const Eigen::Vector3d& q) const;
+  // A force [N] at the limit point of real vertex v, spread with the limit-mask weights.
+  Eigen::VectorXd point_load(int v, const Eigen::Vector3d& force) const;
+
+  // Limit points of the real vertices of the surface with control positions `ext_positions`
+  // (#ext × 3): the limit position mask over each vertex's (closed, extended) one-ring.
+  Eigen::MatrixX3d limit_points(const Eigen::MatrixX3d& ext_positions) const;
+
+ private:
+  // Folds a patch-local vector (3·#patch) into the global vector.
+  void scatter_vector(const ShellElement& el, const Eigen::VectorXd& local, Eigen::VectorXd& global) const;
+
+  ExtendedMesh ext_;
+  DofMap dofs_;
+  ShellMaterial material_;
+  std::vector<ShellElement> elements_;
+};
+
+}  // namespace clothsim

@@ -1,0 +1,30 @@
+// Sparse symmetric positive-definite direct solver (CHOLMOD through Eigen's CholmodSupport).
+// The SuiteSparse headers stay inside the .cpp.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+
+namespace clothsim {
+
+class DirectSolver {
+ public:
+  DirectSolver();
+  ~DirectSolver();
+  DirectSolver(const DirectSolver&) = delete;
+  DirectSolver& operator=(const DirectSolver&) = delete;
+
+  // Analyses and factorises A (symmetric; the lower triangle is read). Returns false when A
+  // is not positive definite (e.g. a structure with an unrestrained rigid motion).
+  bool factorize(const Eigen::SparseMatrix<double>& a);
+  // Solves A x = b with the last factorisation.
+  Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clothsim
