@@ -4,7 +4,7 @@
 set -euo pipefail
 packages=(
   cmake g++ make pkg-config ninja-build
-  libeigen3-dev libsuitesparse-dev libpng-dev libosmesa6-dev libembree-dev libtbb-dev
+  libeigen3-dev libsuitesparse-dev libopenblas0-pthread libpng-dev libosmesa6-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
 )
 missing=()

@@ -1,6 +1,9 @@
 #include "sim/shell/dof_map.hpp"
 
 #include <algorithm>
+#include <Eigen/LU>
+
+#include <limits>
 #include <map>
 
 namespace clothsim {
@@ -65,13 +68,56 @@ DofMap::DofMap(const ExtendedMesh& ext, const std::vector<BoundaryCondition>& co
   for (size_t k = 0; k < ext.ghosts.size(); ++k) {
     const GhostVertex& g = ext.ghosts[k];
     const int id = n + static_cast<int>(k);
+    const GhostMirror mirror = ghost_mirror(ext, static_cast<int>(k));
     for (int c = 0; c < 3; ++c) {
-      if (ghost_clamped[k][c])
-        combos_[3 * id + c] = combos_[3 * g.c + c];
-      else
-        combos_[3 * id + c] = merged({{&combos_[3 * g.a + c], 1.0}, {&combos_[3 * g.b + c], 1.0}, {&combos_[3 * g.c + c], -1.0}});
+      std::vector<std::pair<const Combination*, double>> parts;
+      if (ghost_clamped[k][c]) {  // even reflection: u_g = u(mirror point)
+        for (int i = 0; i < 3; ++i) parts.emplace_back(&combos_[3 * mirror.vertices[i] + c], mirror.weights[i]);
+      } else if (status_[3 * g.a + c] == DofStatus::fixed && status_[3 * g.b + c] == DofStatus::fixed) {
+        // hinged: odd reflection about the edge, u_g = 2 u(edge point) − u(mirror point)
+        parts.emplace_back(&combos_[3 * g.a + c], 2.0 * (1.0 - mirror.edge_parameter));
+        parts.emplace_back(&combos_[3 * g.b + c], 2.0 * mirror.edge_parameter);
+        for (int i = 0; i < 3; ++i) parts.emplace_back(&combos_[3 * mirror.vertices[i] + c], -mirror.weights[i]);
+      } else {  // free edge (Cirak et al. 2000): u_g = u_a + u_b − u_c
+        parts = {{&combos_[3 * g.a + c], 1.0}, {&combos_[3 * g.b + c], 1.0}, {&combos_[3 * g.c + c], -1.0}};
+      }
+      combos_[3 * id + c] = merged(parts);
     }
   }
+}
+
+GhostMirror ghost_mirror(const ExtendedMesh& ext, int ghost) {
+  const GhostVertex& g = ext.ghosts[ghost];
+  const Eigen::Vector3d xa = ext.rest.row(g.a), xb = ext.rest.row(g.b);
+  const Eigen::Vector3d xg = ext.rest.row(ext.num_real + ghost);
+  GhostMirror out;
+  out.edge_parameter = (xg - xa).dot(xb - xa) / (xb - xa).squaredNorm();
+  const Eigen::Vector3d foot = xa + out.edge_parameter * (xb - xa);
+  const Eigen::Vector3d target = 2.0 * foot - xg;
+  // The real triangle around a or b that holds the reflected point best (largest smallest
+  // barycentric coordinate, measured in the triangle's plane).
+  double best = -std::numeric_limits<double>::infinity();
+  for (int centre : {g.a, g.b}) {
+    const std::vector<int>& ring = ext.topology.ring(centre);
+    for (size_t i = 0; i < ring.size(); ++i) {
+      const int p = ring[i], q = ring[(i + 1) % ring.size()];
+      if (p >= ext.num_real || q >= ext.num_real) continue;
+      const Eigen::Vector3d x0 = ext.rest.row(centre), e1 = ext.rest.row(p) - x0.transpose(),
+                            e2 = ext.rest.row(q) - x0.transpose();
+      Eigen::Matrix2d gram;
+      gram << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+      const Eigen::Vector2d rhs(e1.dot(target - x0), e2.dot(target - x0));
+      const Eigen::Vector2d l = gram.inverse() * rhs;
+      const double l0 = 1.0 - l(0) - l(1);
+      const double worst = std::min({l0, l(0), l(1)});
+      if (worst > best + 1e-12) {
+        best = worst;
+        out.vertices = {centre, p, q};
+        out.weights = {l0, l(0), l(1)};
+      }
+    }
+  }
+  return out;
 }
 
 bool DofMap::is_identity(int vertex) const {

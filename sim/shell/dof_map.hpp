@@ -4,10 +4,12 @@
 //
 // All rules act per Cartesian component c ∈ {x, y, z}:
 //  - a free real component is itself; a fixed one is zero;
-//  - ghost g of border edge (a, b) opposite c: u_g = u_a + u_b − u_c (free-edge rule; with u_a,
-//    u_b held at zero this is the hinged rule u_g = −u_c);
+//  - ghost g of a free border edge (a, b) opposite c: u_g = u_a + u_b − u_c (Cirak et al. 2000);
+//  - hinged edge (u_a, u_b fixed): odd reflection about the edge, u_g = 2 u(e) − u(g'), where e
+//    is the foot of g on the edge and g' the mirror image of g across it, u(g') interpolated
+//    linearly in the real triangle that holds g' (zero normal curvature at the edge);
 //  - on a clamped border edge (both ends selected by a clamped condition, component fixed):
-//    u_g = u_c (even reflection) and each selected border vertex b is tied to its interior
+//    u_g = u(g') (even reflection) and each selected border vertex b is tied to its interior
 //    neighbours m, u_b = −½ mean(u_m), which holds the limit surface's value and slope at zero
 //    for data constant along a straight edge (a border vertex with no interior neighbour is
 //    fixed instead).
@@ -18,10 +20,19 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <utility>
 #include <vector>
 
 namespace clothsim {
+
+// Mirror image g' of a ghost across its border edge, as a linear interpolation of real vertices.
+struct GhostMirror {
+  std::array<int, 3> vertices{};
+  std::array<double, 3> weights{};
+  double edge_parameter = 0.5;  // the foot of the ghost on the edge: (1 − s) x_a + s x_b
+};
+GhostMirror ghost_mirror(const ExtendedMesh& ext, int ghost);
 
 enum class DofStatus : unsigned char { free, fixed, dependent };
 

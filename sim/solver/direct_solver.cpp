@@ -5,11 +5,16 @@
 namespace clothsim {
 
 struct DirectSolver::Impl {
-  // LLᵀ, so that a matrix that is not positive definite fails the factorisation.
-  Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  // Supernodal LLᵀ (a matrix that is not positive definite fails the factorisation), AMD
+  // ordering: measured fastest on shell stiffness matrices with OpenBLAS (docs/performance.md).
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
 };
 
-DirectSolver::DirectSolver() : impl_(std::make_unique<Impl>()) {}
+DirectSolver::DirectSolver() : impl_(std::make_unique<Impl>()) {
+  impl_->llt.cholmod().nmethods = 1;
+  impl_->llt.cholmod().method[0].ordering = CHOLMOD_AMD;
+  impl_->llt.cholmod().postorder = 1;
+}
 DirectSolver::~DirectSolver() = default;
 
 bool DirectSolver::factorize(const Eigen::SparseMatrix<double>& a) {

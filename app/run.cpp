@@ -1,0 +1,160 @@
+// The clothsim command's work: scene → static solve → result.json and limit.obj, written into a
+// temporary sibling folder that is renamed into place only once everything has succeeded.
+#include "app/run.hpp"
+
+#include "sim/mesh/obj_io.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/static/static_solve.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace clothsim {
+namespace {
+
+namespace fs = std::filesystem;
+using OrderedJson = nlohmann::ordered_json;
+
+void log_line(const std::string& line) { std::cerr << "clothsim: " << line << '\n'; }
+
+OrderedJson row3(const Eigen::MatrixX3d& m, int row) {
+  return OrderedJson::array({m(row, 0), m(row, 1), m(row, 2)});
+}
+
+std::string result_json(const Scene& scene, const StaticResult& result) {
+  OrderedJson probes = OrderedJson::object();
+  for (const Probe& p : scene.probes) {
+    probes[p.name] = {{"vertex", p.vertex},
+                      {"rest_position", row3(result.limit_rest, p.vertex)},
+                      {"displacement", row3(result.limit_displacement, p.vertex)}};
+  }
+  OrderedJson out = {{"probes", probes},
+                     {"vertices", scene.problem.mesh.num_vertices()},
+                     {"dofs", result.dofs},
+                     {"seconds", {{"assemble", result.assemble_seconds}, {"solve", result.solve_seconds}}}};
+  return out.dump(2) + "\n";
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error(path.string() + ": cannot write file");
+}
+
+// The missing ancestors of `dir` (deepest first), i.e. the folders create_directories(dir) makes.
+std::vector<fs::path> missing_folders(const fs::path& dir) {
+  std::vector<fs::path> missing;
+  std::error_code ec;
+  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  return missing;
+}
+
+// Runs `write(tmp)` on a fresh folder `root/.<name>.tmp-<pid>`, then renames it to `root/<name>`
+// (replacing an older one). On failure removes everything it created, including `root` itself
+// if it did not exist before, and rethrows.
+void publish(const fs::path& root, const std::string& name, const std::function<void(const fs::path&)>& write) {
+  const std::string pid = std::to_string(static_cast<long>(::getpid()));
+  const fs::path final_dir = root / name;
+  const fs::path tmp = root / ("." + name + ".tmp-" + pid);
+  const fs::path old = root / ("." + name + ".old-" + pid);
+  const std::vector<fs::path> created = missing_folders(root);
+  std::error_code ec;
+  try {
+    fs::create_directories(root);
+    fs::remove_all(tmp);
+    fs::create_directory(tmp);
+    write(tmp);
+    const bool replacing = fs::exists(fs::symlink_status(final_dir));
+    if (replacing) fs::rename(final_dir, old);
+    try {
+      fs::rename(tmp, final_dir);
+    } catch (...) {
+      if (replacing) fs::rename(old, final_dir, ec);
+      throw;
+    }
+    if (replacing && fs::remove_all(old, ec) == static_cast<std::uintmax_t>(-1))
+      log_line("warning: could not remove the previous output " + old.string() + ": " + ec.message());
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if empty
+    throw;
+  }
+}
+
+void print_summary(const Scene& scene, const StaticResult& result, const fs::path& dir) {
+  std::ostringstream s;
+  s << std::setprecision(6);
+  s << "scene " << scene.name << " (" << scene.analysis << ")\n";
+  s << "  control vertices " << scene.problem.mesh.num_vertices() << ", triangles "
+    << scene.problem.mesh.num_triangles() << ", free dofs " << result.dofs << "\n";
+  s << "  assemble " << result.assemble_seconds << " s, solve " << result.solve_seconds << " s\n";
+  for (const Probe& p : scene.probes) {
+    const Eigen::MatrixX3d& u = result.limit_displacement;
+    s << "  probe " << p.name << " (vertex " << p.vertex << "): displacement [" << u(p.vertex, 0) << ", "
+      << u(p.vertex, 1) << ", " << u(p.vertex, 2) << "] m\n";
+  }
+  s << "  wrote " << (dir / "result.json").string() << " and " << (dir / "limit.obj").string() << "\n";
+  std::cout << s.str() << std::flush;
+}
+
+void check_result(const Scene& scene, const StaticResult& result) {
+  const Eigen::Index n = scene.problem.mesh.vertices.rows();
+  if (result.limit_rest.rows() != n || result.limit_displacement.rows() != n)
+    throw std::runtime_error(scene.file.string() + ": static analysis returned " +
+                             std::to_string(result.limit_displacement.rows()) + " limit points for " +
+                             std::to_string(n) + " control vertices");
+}
+
+}  // namespace
+
+int run_scene_file(const fs::path& scene_file, const fs::path& out_root) {
+  try {
+    if (out_root.empty()) throw std::runtime_error("--out: the output folder must not be empty");
+    const Scene scene = load_scene(scene_file, log_line);
+    log_line("scene " + scene.name + ": " + std::to_string(scene.problem.mesh.num_vertices()) +
+             " control vertices, " + std::to_string(scene.problem.mesh.num_triangles()) + " triangles");
+
+    StaticResult result;
+    try {
+      result = solve_static(scene.problem);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(scene.file.string() + ": static analysis failed: " + e.what());
+    }
+    check_result(scene, result);
+
+    const std::string json = result_json(scene, result);
+    const Eigen::MatrixX3d deformed = result.limit_rest + result.limit_displacement;
+    const std::string comment = "clothsim: deformed limit surface of scene " + scene.name;
+    try {
+      publish(out_root, scene.name, [&](const fs::path& dir) {
+        write_text(dir / "result.json", json);
+        write_obj((dir / "limit.obj").string(), deformed, scene.problem.mesh.triangles, comment);
+      });
+    } catch (const std::exception& e) {
+      throw std::runtime_error("cannot write the results to " + (out_root / scene.name).string() + ": " + e.what());
+    }
+    print_summary(scene, result, out_root / scene.name);
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "clothsim: error: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace clothsim

@@ -1,0 +1,556 @@
+// Scene loader: parses a scene file with nlohmann::json, checks every key, type and range (the
+// messages carry the file and the key path), builds the mesh and the StaticProblem.
+#include "sim/scene/scene.hpp"
+
+#include "sim/mesh/generators.hpp"
+#include "sim/mesh/obj_io.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <system_error>
+#include <utility>
+
+namespace clothsim {
+namespace {
+
+using Json = nlohmann::json;
+
+const char* const kAxes[3] = {"x", "y", "z"};
+
+std::string join_key(const std::string& path, const std::string& key) {
+  return path.empty() ? key : path + "." + key;
+}
+
+std::string join_index(const std::string& path, std::size_t index) {
+  return path + "[" + std::to_string(index) + "]";
+}
+
+// A string as a JSON string literal (quoted, escaped).
+std::string quote(const std::string& s) { return Json(s).dump(); }
+
+// A double in its shortest round-trip form.
+std::string format_number(double v) { return Json(v).dump(); }
+
+std::string format_point(const Eigen::Vector3d& p) {
+  std::string out = "[";
+  for (int k = 0; k < 3; ++k) out.append(k > 0 ? ", " : "").append(format_number(p[k]));
+  return out.append("]");
+}
+
+// "a, b, c" or, quoted, "\"a\", \"b\", \"c\"".
+std::string format_list(const std::vector<std::string>& items, bool quoted) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) out += ", ";
+    out += quoted ? quote(items[i]) : items[i];
+  }
+  return out;
+}
+
+// What a JSON value is, for "(got ...)" in type errors.
+std::string describe(const Json& j) {
+  switch (j.type()) {
+    case Json::value_t::array: return "an array of " + std::to_string(j.size());
+    case Json::value_t::object: return "an object";
+    case Json::value_t::string: {
+      const std::string s = j.get<std::string>();
+      return s.size() > 40 ? quote(s.substr(0, 40) + "...") : quote(s);
+    }
+    default: return j.dump();
+  }
+}
+
+bool is_safe_name(const std::string& name) {
+  if (name.empty() || name.front() == '.') return false;
+  for (char c : name) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '_' || c == '-' || c == '.';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+// Finds the first repeated key of any object while the parser runs (nlohmann keeps the last
+// value silently), and remembers its key path.
+class DuplicateKeyFinder {
+ public:
+  bool on_event(nlohmann::json::parse_event_t event, Json& parsed) {
+    using E = nlohmann::json::parse_event_t;
+    switch (event) {
+      case E::object_start:
+        element_starts();
+        stack_.push_back({false, {}, 0, {}});
+        break;
+      case E::array_start:
+        element_starts();
+        stack_.push_back({true, {}, 0, {}});
+        break;
+      case E::object_end:
+      case E::array_end:
+        if (!stack_.empty()) stack_.pop_back();
+        break;
+      case E::key:
+        if (!stack_.empty() && parsed.is_string()) {
+          Frame& top = stack_.back();
+          top.key = parsed.get<std::string>();
+          if (!top.keys.insert(top.key).second && first_.empty()) first_ = path();
+        }
+        break;
+      case E::value:
+        element_starts();
+        break;
+    }
+    return true;
+  }
+  const std::string& first_duplicate() const { return first_; }
+
+ private:
+  struct Frame {
+    bool array;
+    std::string key;        // current key (objects)
+    std::size_t count;      // elements started so far (arrays)
+    std::set<std::string> keys;
+  };
+  void element_starts() {
+    if (!stack_.empty() && stack_.back().array) ++stack_.back().count;
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : stack_) p = f.array ? join_index(p, f.count - 1) : join_key(p, f.key);
+    return p;
+  }
+  std::vector<Frame> stack_;
+  std::string first_;
+};
+
+// Typed, checked access to the JSON tree; every failure throws SceneError naming file and key.
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& path, const std::string& problem) const {
+    throw SceneError(file_ + ": " + (path.empty() ? std::string() : path + ": ") + problem);
+  }
+
+  // `j` must be an object whose keys are all in `allowed`.
+  void check_object(const Json& j, const std::string& path,
+                    const std::vector<std::string>& allowed) const {
+    if (!j.is_object()) fail(path, "expected an object (got " + describe(j) + ")");
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      bool known = false;
+      for (const std::string& a : allowed) known = known || a == it.key();
+      if (!known)
+        fail(join_key(path, it.key()), "unknown key (allowed: " + format_list(allowed, false) + ")");
+    }
+  }
+
+  const Json* find(const Json& object, const std::string& key) const {
+    auto it = object.find(key);
+    return it == object.end() ? nullptr : &*it;
+  }
+
+  const Json& require(const Json& object, const std::string& path, const std::string& key) const {
+    const Json* j = find(object, key);
+    if (j == nullptr) fail(join_key(path, key), "required key is missing");
+    return *j;
+  }
+
+  const Json& array(const Json& j, const std::string& path) const {
+    if (!j.is_array()) fail(path, "expected an array (got " + describe(j) + ")");
+    return j;
+  }
+
+  double number(const Json& j, const std::string& path) const {
+    if (!j.is_number()) fail(path, "expected a number (got " + describe(j) + ")");
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) fail(path, "must be a finite number");
+    return v;
+  }
+
+  int integer(const Json& j, const std::string& path) const {
+    if (!j.is_number_integer()) fail(path, "expected an integer (got " + describe(j) + ")");
+    const bool fits = j.is_number_unsigned()
+                          ? j.get<std::uint64_t>() <= static_cast<std::uint64_t>(std::numeric_limits<int>::max())
+                          : (j.get<std::int64_t>() >= std::numeric_limits<int>::min() &&
+                             j.get<std::int64_t>() <= std::numeric_limits<int>::max());
+    if (!fits) fail(path, "integer out of range (got " + j.dump() + ")");
+    return static_cast<int>(j.get<std::int64_t>());
+  }
+
+  std::string string(const Json& j, const std::string& path) const {
+    if (!j.is_string()) fail(path, "expected a string (got " + describe(j) + ")");
+    return j.get<std::string>();
+  }
+
+  // One of `allowed`; `what` names the thing in the error ("value", "component", ...).
+  std::string choice(const Json& j, const std::string& path, const std::vector<std::string>& allowed,
+                     const std::string& what = "value") const {
+    if (!j.is_string())
+      fail(path, "expected a string (got " + describe(j) + "; allowed: " + format_list(allowed, true) + ")");
+    const std::string s = j.get<std::string>();
+    for (const std::string& a : allowed)
+      if (a == s) return s;
+    fail(path, "unknown " + what + " " + quote(s) + " (allowed: " + format_list(allowed, true) + ")");
+  }
+
+  Eigen::Vector3d vec3(const Json& j, const std::string& path) const {
+    if (!j.is_array() || j.size() != 3)
+      fail(path, "expected an array of 3 numbers (got " + describe(j) + ")");
+    Eigen::Vector3d v;
+    for (int k = 0; k < 3; ++k) {
+      const auto idx = static_cast<std::size_t>(k);
+      if (!j[idx].is_number())
+        fail(path, "expected an array of 3 numbers (element " + std::to_string(k) + " is " +
+                       describe(j[idx]) + ")");
+      v[k] = number(j[idx], join_index(path, idx));
+    }
+    return v;
+  }
+
+  // Number > 0 (`unit` like "[m]").
+  double positive(const Json& j, const std::string& path, const std::string& unit) const {
+    const double v = number(j, path);
+    if (!(v > 0)) fail(path, "must be > 0 " + unit + " (got " + j.dump() + ")");
+    return v;
+  }
+
+  double non_negative(const Json& j, const std::string& path, const std::string& unit) const {
+    const double v = number(j, path);
+    if (!(v >= 0)) fail(path, "must be >= 0 " + unit + " (got " + j.dump() + ")");
+    return v;
+  }
+
+  int integer_at_least(const Json& j, const std::string& path, int minimum) const {
+    const int v = integer(j, path);
+    if (v < minimum)
+      fail(path, "must be an integer >= " + std::to_string(minimum) + " (got " + j.dump() + ")");
+    return v;
+  }
+
+  // An array of exactly `n` elements.
+  const Json& sized_array(const Json& j, const std::string& path, std::size_t n,
+                          const std::string& of) const {
+    if (!j.is_array() || j.size() != n)
+      fail(path, "expected an array of " + std::to_string(n) + " " + of + " (got " + describe(j) + ")");
+    return j;
+  }
+
+ private:
+  std::string file_;
+};
+
+Json parse_file(const Reader& r, const std::filesystem::path& file) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) r.fail("", "is a directory, not a scene file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    const bool exists = std::filesystem::exists(file, ec);
+    r.fail("", exists ? "cannot open the scene file for reading" : "cannot open the scene file (no such file)");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) r.fail("", "cannot read the scene file");
+
+  DuplicateKeyFinder duplicates;
+  Json j;
+  try {
+    j = Json::parse(text.str(), [&duplicates](int, nlohmann::json::parse_event_t event, Json& parsed) {
+      return duplicates.on_event(event, parsed);
+    });
+  } catch (const nlohmann::json::exception& e) {
+    std::string message = e.what();
+    // Drop nlohmann's "[json.exception.parse_error.101] " tag.
+    if (!message.empty() && message.front() == '[') {
+      const auto close = message.find("] ");
+      if (close != std::string::npos) message = message.substr(close + 2);
+    }
+    r.fail("", "malformed JSON: " + message);
+  }
+  if (!duplicates.first_duplicate().empty())
+    r.fail(duplicates.first_duplicate(), "duplicate key (each key may appear only once)");
+  if (!j.is_object()) r.fail("", "expected a JSON object at the top level (got " + describe(j) + ")");
+  return j;
+}
+
+TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log) {
+  const std::string path = "mesh";
+  if (!j.is_object()) r.fail(path, "expected an object (got " + describe(j) + ")");
+  const bool has_obj = j.contains("obj");
+  const bool has_primitive = j.contains("primitive");
+  if (has_obj && has_primitive) r.fail(path, "give either \"obj\" or \"primitive\", not both");
+  if (!has_obj && !has_primitive)
+    r.fail(path, "needs \"obj\" (a file) or \"primitive\" (allowed: \"grid\", \"cylinder\")");
+
+  if (has_obj) {
+    r.check_object(j, path, {"obj"});
+    const std::string key = "mesh.obj";
+    const std::string name = r.string(j["obj"], key);
+    if (name.empty()) r.fail(key, "expected a non-empty file path");
+    const std::filesystem::path obj = folder / name;
+    try {
+      TriMesh mesh = read_obj(obj.string());
+      log("mesh: " + obj.string() + ": " + std::to_string(mesh.num_vertices()) + " vertices, " +
+          std::to_string(mesh.num_triangles()) + " triangles");
+      return mesh;
+    } catch (const std::exception& e) {
+      r.fail(key, e.what());
+    }
+  }
+
+  const std::string primitive = r.choice(j["primitive"], "mesh.primitive", {"grid", "cylinder"}, "primitive");
+  TriMesh mesh;
+  try {
+    if (primitive == "grid") {
+      r.check_object(j, path, {"primitive", "size", "divisions"});
+      const Json& size = r.sized_array(r.require(j, path, "size"), "mesh.size", 2, "numbers");
+      const Json& div = r.sized_array(r.require(j, path, "divisions"), "mesh.divisions", 2, "integers");
+      const double sx = r.positive(size[0], "mesh.size[0]", "[m]");
+      const double sy = r.positive(size[1], "mesh.size[1]", "[m]");
+      const int dx = r.integer_at_least(div[0], "mesh.divisions[0]", 1);
+      const int dy = r.integer_at_least(div[1], "mesh.divisions[1]", 1);
+      mesh = make_grid(sx, sy, dx, dy);
+      log("mesh: grid " + format_number(sx) + " m x " + format_number(sy) + " m, " + std::to_string(dx) +
+          " x " + std::to_string(dy) + " divisions");
+    } else {
+      r.check_object(j, path, {"primitive", "radius", "length", "segments", "rings"});
+      const double radius = r.positive(r.require(j, path, "radius"), "mesh.radius", "[m]");
+      const double length = r.positive(r.require(j, path, "length"), "mesh.length", "[m]");
+      const int segments = r.integer_at_least(r.require(j, path, "segments"), "mesh.segments", 3);
+      const int rings = r.integer_at_least(r.require(j, path, "rings"), "mesh.rings", 2);
+      mesh = make_cylinder(radius, length, segments, rings);
+      log("mesh: cylinder r = " + format_number(radius) + " m, L = " + format_number(length) + " m, " +
+          std::to_string(segments) + " segments, " + std::to_string(rings) + " rings");
+    }
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::exception& e) {
+    r.fail(path, e.what());
+  }
+  return mesh;
+}
+
+ShellMaterial read_material(const Reader& r, const Json* j) {
+  double youngs = 1e7, poisson = 0.3, thickness = 0.001, density = 1000.0;
+  if (j == nullptr) return ShellMaterial::from_solid(youngs, poisson, thickness, density);
+  const std::string path = "material";
+  r.check_object(*j, path,
+                 {"youngs_modulus", "poisson_ratio", "thickness", "density", "stretch_modulus",
+                  "bending_rigidity", "areal_density"});
+  if (const Json* v = r.find(*j, "youngs_modulus")) youngs = r.positive(*v, "material.youngs_modulus", "[Pa]");
+  if (const Json* v = r.find(*j, "poisson_ratio")) {
+    poisson = r.number(*v, "material.poisson_ratio");
+    if (!(poisson >= 0 && poisson < 0.5))
+      r.fail("material.poisson_ratio", "must be >= 0 and < 0.5 (got " + v->dump() + ")");
+  }
+  if (const Json* v = r.find(*j, "thickness")) thickness = r.positive(*v, "material.thickness", "[m]");
+  if (const Json* v = r.find(*j, "density")) density = r.non_negative(*v, "material.density", "[kg/m³]");
+
+  ShellMaterial m = ShellMaterial::from_solid(youngs, poisson, thickness, density);
+  if (const Json* v = r.find(*j, "stretch_modulus"))
+    m.stretch_modulus = r.positive(*v, "material.stretch_modulus", "[N/m]");
+  if (const Json* v = r.find(*j, "bending_rigidity"))
+    m.bending_rigidity = r.positive(*v, "material.bending_rigidity", "[N·m]");
+  if (const Json* v = r.find(*j, "areal_density"))
+    m.areal_density = r.non_negative(*v, "material.areal_density", "[kg/m²]");
+  const std::string problem = validate(m);
+  if (!problem.empty()) r.fail(path, problem);
+  return m;
+}
+
+Quadrature read_numerics(const Reader& r, const Json* j) {
+  if (j == nullptr) return Quadrature::one_point;
+  r.check_object(*j, "numerics", {"quadrature"});
+  const Json* q = r.find(*j, "quadrature");
+  if (q == nullptr) return Quadrature::one_point;
+  const std::string s = r.choice(*q, "numerics.quadrature", {"one_point", "three_point", "six_point"});
+  if (s == "three_point") return Quadrature::three_point;
+  if (s == "six_point") return Quadrature::six_point;
+  return Quadrature::one_point;
+}
+
+std::string bounding_box(const Eigen::MatrixX3d& v) {
+  if (v.rows() == 0) return "empty";
+  const Eigen::Vector3d lo = v.colwise().minCoeff().transpose();
+  const Eigen::Vector3d hi = v.colwise().maxCoeff().transpose();
+  return "[" + format_point(lo) + ", " + format_point(hi) + "]";
+}
+
+std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, const TriMesh& mesh,
+                                             const LogFn& log) {
+  std::vector<BoundaryCondition> out;
+  if (j == nullptr) return out;
+  r.array(*j, "boundary");
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string path = join_index("boundary", i);
+    const Json& item = (*j)[i];
+    r.check_object(item, path, {"select", "fix", "rotation"});
+    BoundaryCondition bc;
+
+    const std::string select_path = join_key(path, "select");
+    const Json& select = r.require(item, path, "select");
+    r.check_object(select, select_path, {"box"});
+    const std::string box_path = join_key(select_path, "box");
+    const Json& box = r.require(select, select_path, "box");
+    if (!box.is_array() || box.size() != 2)
+      r.fail(box_path, "expected an array of 2 points [[xmin, ymin, zmin], [xmax, ymax, zmax]] (got " +
+                           describe(box) + ")");
+    const Eigen::Vector3d lo = r.vec3(box[0], join_index(box_path, 0));
+    const Eigen::Vector3d hi = r.vec3(box[1], join_index(box_path, 1));
+    for (int k = 0; k < 3; ++k)
+      if (lo[k] > hi[k])
+        r.fail(box_path, std::string("min must be <= max in every component (got ") + kAxes[k] + "min = " +
+                             format_number(lo[k]) + " > " + kAxes[k] + "max = " + format_number(hi[k]) + ")");
+
+    if (const Json* fix = r.find(item, "fix")) {
+      const std::string fix_path = join_key(path, "fix");
+      r.array(*fix, fix_path);
+      bc.fix = {false, false, false};
+      for (std::size_t c = 0; c < fix->size(); ++c) {
+        const std::string component = r.choice((*fix)[c], join_index(fix_path, c), {"x", "y", "z"}, "component");
+        const auto axis = static_cast<std::size_t>(component[0] - 'x');
+        if (bc.fix[axis]) r.fail(join_index(fix_path, c), "duplicate component " + quote(component));
+        bc.fix[axis] = true;
+      }
+    }
+    if (const Json* rotation = r.find(item, "rotation"))
+      bc.clamped = r.choice(*rotation, join_key(path, "rotation"), {"free", "clamped"}) == "clamped";
+
+    bc.vertices = select_box(mesh.vertices, lo, hi);
+    if (bc.vertices.empty())
+      r.fail(box_path, "selects no vertex of the mesh (mesh bounding box: " + bounding_box(mesh.vertices) + ")");
+    log(path + ": " + std::to_string(bc.vertices.size()) + " vertices");
+    out.push_back(std::move(bc));
+  }
+  return out;
+}
+
+// "vertex 12 at [x, y, z] (0.01 m from the requested point)" for snapped points.
+std::string describe_snap(const Eigen::MatrixX3d& vertices, int v, const Eigen::Vector3d& at) {
+  const Eigen::Vector3d p = vertices.row(v).transpose();
+  return "vertex " + std::to_string(v) + " at " + format_point(p) + " (" + format_number((p - at).norm()) +
+         " m from the requested point)";
+}
+
+void read_loads(const Reader& r, const Json* j, StaticProblem& problem, const LogFn& log) {
+  if (j == nullptr) return;
+  r.check_object(*j, "loads", {"gravity", "surface_load", "point_loads"});
+  if (const Json* g = r.find(*j, "gravity")) problem.gravity = r.vec3(*g, "loads.gravity");
+  if (const Json* s = r.find(*j, "surface_load")) problem.surface_load = r.vec3(*s, "loads.surface_load");
+  if (const Json* p = r.find(*j, "point_loads")) {
+    r.array(*p, "loads.point_loads");
+    for (std::size_t i = 0; i < p->size(); ++i) {
+      const std::string path = join_index("loads.point_loads", i);
+      const Json& item = (*p)[i];
+      r.check_object(item, path, {"at", "force"});
+      const Eigen::Vector3d at = r.vec3(r.require(item, path, "at"), join_key(path, "at"));
+      PointLoad load;
+      load.force = r.vec3(r.require(item, path, "force"), join_key(path, "force"));
+      load.vertex = nearest_vertex(problem.mesh.vertices, at);
+      log(path + ": " + describe_snap(problem.mesh.vertices, load.vertex, at));
+      problem.point_loads.push_back(load);
+    }
+  }
+}
+
+std::vector<Probe> read_probes(const Reader& r, const Json* j, const TriMesh& mesh, const LogFn& log) {
+  std::vector<Probe> out;
+  if (j == nullptr) return out;
+  r.array(*j, "probes");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string path = join_index("probes", i);
+    const Json& item = (*j)[i];
+    r.check_object(item, path, {"name", "at"});
+    Probe probe;
+    probe.name = r.string(r.require(item, path, "name"), join_key(path, "name"));
+    if (probe.name.empty()) r.fail(join_key(path, "name"), "must not be empty");
+    if (!names.insert(probe.name).second)
+      r.fail(join_key(path, "name"), "duplicate probe name " + quote(probe.name));
+    probe.at = r.vec3(r.require(item, path, "at"), join_key(path, "at"));
+    probe.vertex = nearest_vertex(mesh.vertices, probe.at);
+    log("probe " + probe.name + ": " + describe_snap(mesh.vertices, probe.vertex, probe.at));
+    out.push_back(std::move(probe));
+  }
+  return out;
+}
+
+}  // namespace
+
+int nearest_vertex(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& point) {
+  int best = -1;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
+    const double d2 = (vertices.row(v).transpose() - point).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = static_cast<int>(v);
+    }
+  }
+  return best;
+}
+
+std::vector<int> select_box(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& lo,
+                            const Eigen::Vector3d& hi) {
+  std::vector<int> out;
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
+    bool inside = true;
+    for (Eigen::Index k = 0; k < 3; ++k) inside = inside && vertices(v, k) >= lo[k] && vertices(v, k) <= hi[k];
+    if (inside) out.push_back(static_cast<int>(v));
+  }
+  return out;
+}
+
+Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
+  const LogFn say = log ? log : LogFn([](const std::string&) {});
+  const Reader r(file.string());
+  const Json root = parse_file(r, file);
+  r.check_object(root, "",
+                 {"name", "description", "analysis", "mesh", "material", "boundary", "loads", "probes",
+                  "numerics"});
+
+  Scene scene;
+  scene.file = file;
+  if (const Json* name = r.find(root, "name")) {
+    scene.name = r.string(*name, "name");
+    if (!is_safe_name(scene.name))
+      r.fail("name", "must be a safe folder name: letters, digits, '_', '-', '.', not starting with '.' (got " +
+                         quote(scene.name) + ")");
+  } else {
+    scene.name = file.stem().string();
+    if (!is_safe_name(scene.name))
+      r.fail("name", "not given, and the file name " + quote(scene.name) +
+                         " is not a safe folder name; set \"name\" (letters, digits, '_', '-', '.', not "
+                         "starting with '.')");
+  }
+  if (const Json* d = r.find(root, "description")) scene.description = r.string(*d, "description");
+  scene.analysis = "static";
+  if (const Json* a = r.find(root, "analysis")) {
+    if (a->is_string() && a->get<std::string>() == "dynamic")
+      r.fail("analysis", "dynamic analysis is not available yet (allowed: \"static\")");
+    scene.analysis = r.choice(*a, "analysis", {"static"});
+  }
+
+  // Cheap checks first, the mesh (possibly large) after.
+  scene.problem.material = read_material(r, r.find(root, "material"));
+  scene.problem.quadrature = read_numerics(r, r.find(root, "numerics"));
+
+  TriMesh mesh = build_mesh(r, r.require(root, "", "mesh"), file.parent_path(), say);
+  try {
+    scene.problem.mesh = prepare_control_mesh(mesh, say);
+  } catch (const std::exception& e) {
+    r.fail("mesh", e.what());
+  }
+
+  scene.problem.boundary = read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, say);
+  read_loads(r, r.find(root, "loads"), scene.problem, say);
+  scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
+  return scene;
+}
+
+}  // namespace clothsim

@@ -1,0 +1,52 @@
+// Scene files: loading and validating the JSON description of one analysis (mesh, material,
+// boundary conditions, loads, probes, numerics; contract in scenes/README.md) into a
+// StaticProblem. Every error is a SceneError whose message starts with the scene file's path and
+// the key path ("scenes/x.json: boundary[0].fix[1]: unknown component ...").
+#pragma once
+
+#include "sim/static/static_solve.hpp"
+
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A named point whose displacement is reported after the analysis.
+struct Probe {
+  std::string name;
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();  // requested position [m]
+  int vertex = -1;                               // nearest control vertex of the prepared mesh
+};
+
+struct Scene {
+  std::string name;             // safe folder name: [A-Za-z0-9_.-]+, not starting with '.'
+  std::string description;
+  std::filesystem::path file;   // the scene file, as given to load_scene
+  std::string analysis;         // "static"
+  StaticProblem problem;        // mesh already passed through prepare_control_mesh
+  std::vector<Probe> probes;
+};
+
+// Reads, validates and builds the scene in `file`; relative mesh paths are resolved against the
+// file's folder. Log lines (mesh preparation, selection sizes) go to `log`, which may be empty.
+// Throws SceneError.
+Scene load_scene(const std::filesystem::path& file, const LogFn& log);
+
+// Index of the row of `vertices` [m] nearest to `point` [m] (Euclidean; ties → lowest index),
+// or -1 if there are no vertices.
+int nearest_vertex(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& point);
+
+// Indices (ascending) of the rows p of `vertices` [m] inside the closed box lo <= p <= hi [m].
+std::vector<int> select_box(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& lo,
+                            const Eigen::Vector3d& hi);
+
+}  // namespace clothsim
