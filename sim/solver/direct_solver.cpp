@@ -14,6 +14,7 @@ DirectSolver::DirectSolver() : impl_(std::make_unique<Impl>()) {
   impl_->llt.cholmod().nmethods = 1;
   impl_->llt.cholmod().method[0].ordering = CHOLMOD_AMD;
   impl_->llt.cholmod().postorder = 1;
+  impl_->llt.cholmod().print = 0;  // failures are reported by factorize()'s return value
 }
 DirectSolver::~DirectSolver() = default;
 
