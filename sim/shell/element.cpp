@@ -71,21 +71,23 @@ Eigen::Matrix<double, 6, 1> nonlinear_strains(const BasisMatrix& basis, const Ei
   return e;
 }
 
-void add_element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
-                           const Eigen::MatrixX3d& rest, const ShellMaterial& material, Eigen::MatrixXd& k) {
+ElementMatrix element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
+                                const Eigen::MatrixX3d& rest, const ShellMaterial& material) {
   const Eigen::Index dofs = 3 * rest.rows();
-  if (k.size() == 0) k = Eigen::MatrixXd::Zero(dofs, dofs);
+  ElementMatrix k = ElementMatrix::Zero(dofs, dofs);
   StrainMatrix m, b;
+  Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxPatchDofs> hm_m, hb_b;
   for (size_t q = 0; q < basis.size(); ++q) {
     const SurfacePoint s = surface_point(basis[q], rest);
     const Eigen::Matrix3d h = material_matrix(s, material.poisson_ratio);
     strain_matrices(basis[q], s, m, b);
     const double scale = weights[q] * s.j;
-    const Eigen::Matrix3d hm = (scale * material.membrane_stiffness()) * h;
-    const Eigen::Matrix3d hb = (scale * material.bending_stiffness()) * h;
-    k.noalias() += m.transpose() * (hm * m);
-    k.noalias() += b.transpose() * (hb * b);
+    hm_m.noalias() = ((scale * material.membrane_stiffness()) * h) * m;
+    hb_b.noalias() = ((scale * material.bending_stiffness()) * h) * b;
+    k.noalias() += m.transpose() * hm_m;
+    k.noalias() += b.transpose() * hb_b;
   }
+  return k;
 }
 
 }  // namespace clothsim

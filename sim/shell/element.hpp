@@ -14,8 +14,16 @@
 
 namespace clothsim {
 
+// Largest patch: an irregular vertex of valence 12 has 12 + 6 control vertices.
+constexpr int kMaxPatchVertices = 18;
+constexpr int kMaxPatchDofs = 3 * kMaxPatchVertices;
+
 using BasisMatrix = Eigen::Matrix<double, 6, Eigen::Dynamic>;  // rows: BasisRow of box_spline.hpp
-using StrainMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic>;  // 3 × 3n
+// 3 × 3n, stack-allocated.
+using StrainMatrix = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxPatchDofs>;
+// 3n × 3n element matrix, stack-allocated.
+using ElementMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, kMaxPatchDofs, kMaxPatchDofs>;
 
 // Geometry of the reference surface at one point.
 struct SurfacePoint {
@@ -38,9 +46,8 @@ void strain_matrices(const BasisMatrix& basis, const SurfacePoint& s, StrainMatr
 Eigen::Matrix<double, 6, 1> nonlinear_strains(const BasisMatrix& basis, const Eigen::MatrixX3d& rest,
                                               const Eigen::MatrixX3d& deformed);
 
-// Adds Σ_q weight_q · j (K_m Mᵀ H M + D_b Bᵀ H B) for the given quadrature points to `k`
-// (3n × 3n, resized and zeroed when empty).
-void add_element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
-                           const Eigen::MatrixX3d& rest, const ShellMaterial& material, Eigen::MatrixXd& k);
+// Σ_q weight_q · j (K_m Mᵀ H M + D_b Bᵀ H B) over the given quadrature points (3n × 3n).
+ElementMatrix element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
+                                const Eigen::MatrixX3d& rest, const ShellMaterial& material);
 
 }  // namespace clothsim

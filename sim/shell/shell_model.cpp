@@ -3,7 +3,11 @@
 #include "sim/subdivision/loop.hpp"
 #include "sim/subdivision/patch.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <bitset>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -66,12 +70,88 @@ ShellModel::ShellModel(const TriMesh& mesh, const ShellMaterial& material,
       throw MeshError("triangle " + std::to_string(t) + " has more than one irregular vertex; refine the mesh first");
     elements_.push_back(make_element(ext_, dofs_, tri, rule));
   }
+  build_pattern();
+  build_colors();
+}
+
+void ShellModel::build_pattern() {
+  const int n = num_vertices();
+  std::vector<std::vector<int>> nb(n);
+  for (int v = 0; v < n; ++v) nb[v].push_back(v);
+  for (const ShellElement& el : elements_)
+    for (int j : el.real) nb[j].insert(nb[j].end(), el.real.begin(), el.real.end());
+  for (auto& list : nb) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  std::vector<int> column_start(3 * n + 1, 0);
+  block_stride_.resize(n);
+  for (int j = 0; j < n; ++j) {
+    block_stride_[j] = 3 * static_cast<int>(nb[j].size());
+    for (int d = 0; d < 3; ++d) column_start[3 * j + d + 1] = column_start[3 * j + d] + block_stride_[j];
+  }
+  const int nnz = column_start[3 * n];
+  pattern_ = Eigen::SparseMatrix<double>(3 * n, 3 * n);
+  pattern_.makeCompressed();
+  pattern_.resizeNonZeros(nnz);
+  std::copy(column_start.begin(), column_start.end(), pattern_.outerIndexPtr());
+  for (int j = 0; j < n; ++j)
+    for (int d = 0; d < 3; ++d) {
+      int pos = column_start[3 * j + d];
+      for (int i : nb[j])
+        for (int c = 0; c < 3; ++c) pattern_.innerIndexPtr()[pos++] = 3 * i + c;
+    }
+  std::fill(pattern_.valuePtr(), pattern_.valuePtr() + nnz, 0.0);
+  slots_.resize(elements_.size());
+  for (size_t e = 0; e < elements_.size(); ++e) {
+    const std::vector<int>& real = elements_[e].real;
+    const size_t m = real.size();
+    slots_[e].resize(m * m);
+    for (size_t b = 0; b < m; ++b) {
+      const std::vector<int>& list = nb[real[b]];
+      for (size_t a = 0; a < m; ++a) {
+        const auto slot = std::lower_bound(list.begin(), list.end(), real[a]) - list.begin();
+        slots_[e][a + m * b] = column_start[3 * real[b]] + 3 * static_cast<int>(slot);
+      }
+    }
+  }
+}
+
+void ShellModel::build_colors() {
+  // Greedy colouring: an element takes the lowest colour not yet used at any of its vertices.
+  constexpr size_t kMaxColors = 256;
+  std::vector<std::bitset<kMaxColors>> used(num_vertices());
+  for (int e = 0; e < static_cast<int>(elements_.size()); ++e) {
+    std::bitset<kMaxColors> taken;
+    for (int v : elements_[e].real) taken |= used[v];
+    size_t color = 0;
+    while (color < kMaxColors && taken[color]) ++color;
+    if (color == kMaxColors) throw std::logic_error("element colouring needs more than 256 colours");
+    for (int v : elements_[e].real) used[v].set(color);
+    if (color >= colors_.size()) colors_.resize(color + 1);
+    colors_[color].push_back(e);
+  }
+}
+
+template <class Matrix>
+void ShellModel::scatter_matrix(int e, const Matrix& local, double* values) const {
+  const std::vector<int>& real = elements_[e].real;
+  const std::vector<int>& slots = slots_[e];
+  const size_t m = real.size();
+  for (size_t b = 0; b < m; ++b) {
+    const int stride = block_stride_[real[b]];
+    for (size_t a = 0; a < m; ++a) {
+      double* block = values + slots[a + m * b];
+      for (int d = 0; d < 3; ++d)
+        for (int c = 0; c < 3; ++c)
+          block[d * stride + c] += local(3 * static_cast<Eigen::Index>(a) + c, 3 * static_cast<Eigen::Index>(b) + d);
+    }
+  }
 }
 
 Eigen::MatrixXd ShellModel::folded_element_stiffness(int e) const {
   const ShellElement& el = elements_[e];
-  Eigen::MatrixXd k;
-  add_element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, k);
+  const ElementMatrix k = element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_);
   if (el.identity) return k;
   const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size()), nr = static_cast<Eigen::Index>(el.real.size());
   Eigen::MatrixXd t = Eigen::MatrixXd::Zero(3 * np, 3 * nr);
@@ -82,50 +162,22 @@ Eigen::MatrixXd ShellModel::folded_element_stiffness(int e) const {
 }
 
 Eigen::SparseMatrix<double> ShellModel::stiffness() const {
-  const int n = num_vertices();
-  // Block pattern: column block j holds row blocks nb[j] (sorted), each 3 × 3 dense.
-  std::vector<std::vector<int>> nb(n);
-  for (int v = 0; v < n; ++v) nb[v].push_back(v);
-  for (const ShellElement& el : elements_)
-    for (int j : el.real) nb[j].insert(nb[j].end(), el.real.begin(), el.real.end());
-  for (auto& list : nb) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-  }
-  std::vector<Eigen::Index> column_start(3 * n + 1, 0);
-  for (int j = 0; j < n; ++j)
-    for (int d = 0; d < 3; ++d) column_start[3 * j + d + 1] = column_start[3 * j + d] + 3 * static_cast<Eigen::Index>(nb[j].size());
-  const Eigen::Index nnz = column_start[3 * n];
-  Eigen::SparseMatrix<double> k(3 * n, 3 * n);
-  k.makeCompressed();
-  k.resizeNonZeros(nnz);
-  for (Eigen::Index c = 0; c <= 3 * n; ++c) k.outerIndexPtr()[c] = static_cast<int>(column_start[c]);
-  for (int j = 0; j < n; ++j)
-    for (int d = 0; d < 3; ++d) {
-      Eigen::Index pos = column_start[3 * j + d];
-      for (int i : nb[j])
-        for (int c = 0; c < 3; ++c) k.innerIndexPtr()[pos++] = 3 * i + c;
-    }
-  std::fill(k.valuePtr(), k.valuePtr() + nnz, 0.0);
-
-  std::vector<Eigen::Index> local_index;
-  for (int e = 0; e < static_cast<int>(elements_.size()); ++e) {
-    const ShellElement& el = elements_[e];
-    const Eigen::MatrixXd ke = folded_element_stiffness(e);
-    const Eigen::Index m = static_cast<Eigen::Index>(el.real.size());
-    for (Eigen::Index b = 0; b < m; ++b) {
-      const int j = el.real[b];
-      const std::vector<int>& list = nb[j];
-      const Eigen::Index stride = 3 * static_cast<Eigen::Index>(list.size());
-      for (Eigen::Index a = 0; a < m; ++a) {
-        const Eigen::Index slot = std::lower_bound(list.begin(), list.end(), el.real[a]) - list.begin();
-        const Eigen::Index base = column_start[3 * j] + 3 * slot;
-        for (int d = 0; d < 3; ++d)
-          for (int c = 0; c < 3; ++c) k.valuePtr()[base + d * stride + c] += ke(3 * a + c, 3 * b + d);
+  Eigen::SparseMatrix<double> k = pattern_;
+  double* values = k.valuePtr();
+  // Colour by colour; elements of one colour share no vertex, so their scatters never collide
+  // and the sum in every entry is taken in the same order on every run.
+  for (const std::vector<int>& group : colors_)
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, group.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const int e = group[i];
+        const ShellElement& el = elements_[e];
+        if (el.identity)
+          scatter_matrix(e, element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_), values);
+        else
+          scatter_matrix(e, folded_element_stiffness(e), values);
       }
-    }
-  }
-  for (int v = 0; v < n; ++v)
+    });
+  for (int v = 0; v < num_vertices(); ++v)
     for (int c = 0; c < 3; ++c)
       if (!dofs_.is_free(v, c)) k.coeffRef(3 * v + c, 3 * v + c) = 1.0;
   return k;

@@ -48,6 +48,8 @@ class ShellModel {
   Eigen::SparseMatrix<double> stiffness() const;
   // Element stiffness folded onto the element's real vertices (3·#real square).
   Eigen::MatrixXd folded_element_stiffness(int e) const;
+  // Number of colour groups used for parallel assembly (elements of one group share no vertex).
+  int num_colors() const { return static_cast<int>(colors_.size()); }
 
   // Consistent load of a force per unit reference area q [N/m²]: f_I = ∫ N_I q dA.
   Eigen::VectorXd area_load(const Eigen::Vector3d& q) const;
@@ -61,11 +63,21 @@ class ShellModel {
  private:
   // Folds a patch-local vector (3·#patch) into the global vector.
   void scatter_vector(const ShellElement& el, const Eigen::VectorXd& local, Eigen::VectorXd& global) const;
+  void build_pattern();
+  void build_colors();
+  template <class Matrix>
+  void scatter_matrix(int e, const Matrix& local, double* values) const;
 
   ExtendedMesh ext_;
   DofMap dofs_;
   ShellMaterial material_;
   std::vector<ShellElement> elements_;
+  // Sparsity of the stiffness (3 × 3 blocks between vertices sharing an element) and, per
+  // element, the value offset of each block (a, b) of its real vertices at slots[a + m·b].
+  Eigen::SparseMatrix<double> pattern_;
+  std::vector<std::vector<int>> slots_;
+  std::vector<int> block_stride_;          // per vertex j: entries in one column of block column j
+  std::vector<std::vector<int>> colors_;   // element ids per colour group
 };
 
 }  // namespace clothsim
