@@ -96,4 +96,34 @@ TriMesh make_cylinder(double radius, double length, int segments, int rings) {
   return mesh;
 }
 
+TriMesh make_cylinder_panel(double radius, double length, double angle_deg, int segments, int rings) {
+  require_positive(radius, "radius", "make_cylinder_panel");
+  require_positive(length, "length", "make_cylinder_panel");
+  if (!(angle_deg > 0.0 && angle_deg < 360.0))
+    throw std::invalid_argument("make_cylinder_panel: angle_deg must lie in (0, 360), got " + std::to_string(angle_deg));
+  if (segments < 1)
+    throw std::invalid_argument("make_cylinder_panel: segments must be at least 1, got " + std::to_string(segments));
+  if (rings < 2) throw std::invalid_argument("make_cylinder_panel: rings must be at least 2, got " + std::to_string(rings));
+  require_fits(std::int64_t{segments + 1} * rings, 2 * std::int64_t{segments} * (std::int64_t{rings} - 1),
+               "make_cylinder_panel");
+  const int per_ring = segments + 1;
+  const double angle = angle_deg * std::numbers::pi / 180.0;
+  TriMesh mesh;
+  mesh.vertices.resize(per_ring * rings, 3);
+  for (int r = 0; r < rings; ++r)
+    for (int k = 0; k < per_ring; ++k) {
+      const double phi = angle * (static_cast<double>(k) / segments - 0.5);
+      mesh.vertices.row(r * per_ring + k) << radius * std::sin(phi), length * static_cast<double>(r) / (rings - 1),
+          radius * std::cos(phi);
+    }
+  // k → k+1 moves towards +x at the crown; (k, r) → (k+1, r) → (k+1, r+1) then faces outwards.
+  for (int r = 0; r + 1 < rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      const int a = r * per_ring + k, b = a + 1, c = b + per_ring, d = a + per_ring;
+      mesh.triangles.push_back({a, b, c});
+      mesh.triangles.push_back({a, c, d});
+    }
+  return mesh;
+}
+
 }  // namespace clothsim

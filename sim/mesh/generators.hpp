@@ -23,4 +23,12 @@ TriMesh make_grid(double size_x, double size_y, int divisions_x, int divisions_y
 // segments < 3 or rings < 2.
 TriMesh make_cylinder(double radius, double length, int segments, int rings);
 
+// Open cylindrical panel (e.g. the Scordelis–Lo roof): the part of the cylinder of the given
+// radius [m] about the y axis that spans `angle_deg` (0 < angle < 360) symmetrically about +z,
+// from y = 0 to y = length [m], with `segments` divisions around (segments + 1 vertices per
+// ring) and `rings` rings. Vertex k of ring r has index r·(segments + 1) + k and position
+// (radius·sin φ, y, radius·cos φ), φ = angle·(k/segments − ½). Same diagonal everywhere;
+// normals point away from the axis. Throws std::invalid_argument for bad arguments.
+TriMesh make_cylinder_panel(double radius, double length, double angle_deg, int segments, int rings);
+
 }  // namespace clothsim

@@ -318,13 +318,20 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
       log("mesh: grid " + format_number(sx) + " m x " + format_number(sy) + " m, " + std::to_string(dx) +
           " x " + std::to_string(dy) + " divisions");
     } else {
-      r.check_object(j, path, {"primitive", "radius", "length", "segments", "rings"});
+      r.check_object(j, path, {"primitive", "radius", "length", "segments", "rings", "angle_deg"});
       const double radius = r.positive(r.require(j, path, "radius"), "mesh.radius", "[m]");
       const double length = r.positive(r.require(j, path, "length"), "mesh.length", "[m]");
-      const int segments = r.integer_at_least(r.require(j, path, "segments"), "mesh.segments", 3);
+      double angle = 360.0;
+      if (const Json* a = r.find(j, "angle_deg")) {
+        angle = r.positive(*a, "mesh.angle_deg", "[deg]");
+        if (angle > 360.0) r.fail("mesh.angle_deg", "must be <= 360 [deg] (got " + a->dump() + ")");
+      }
+      const int segments = r.integer_at_least(r.require(j, path, "segments"), "mesh.segments", angle < 360.0 ? 1 : 3);
       const int rings = r.integer_at_least(r.require(j, path, "rings"), "mesh.rings", 2);
-      mesh = make_cylinder(radius, length, segments, rings);
+      mesh = angle < 360.0 ? make_cylinder_panel(radius, length, angle, segments, rings)
+                           : make_cylinder(radius, length, segments, rings);
       log("mesh: cylinder r = " + format_number(radius) + " m, L = " + format_number(length) + " m, " +
+          (angle < 360.0 ? "open panel of " + format_number(angle) + " deg, " : std::string()) +
           std::to_string(segments) + " segments, " + std::to_string(rings) + " rings");
     }
   } catch (const SceneError&) {

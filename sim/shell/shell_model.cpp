@@ -8,7 +8,11 @@
 
 #include <algorithm>
 #include <bitset>
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -227,6 +231,51 @@ Eigen::MatrixX3d ShellModel::limit_points(const Eigen::MatrixX3d& x) const {
     Eigen::RowVector3d p = (1.0 - valence * w) * x.row(v);
     for (int r : ring) p += w * x.row(r);
     out.row(v) = p;
+  }
+  return out;
+}
+
+std::vector<std::string> ShellModel::unrestrained_rigid_motions() const {
+  // A rigid motion r = t + ω × (X − centroid)/size moves the model without strain exactly when
+  // every displacement the DOF map derives (fixed components: zero; tied components and ghosts:
+  // their combinations of free components) agrees with r there. Collect those residuals for the
+  // six basis motions and find the null space of their Gram matrix.
+  const int n = num_vertices();
+  const Eigen::MatrixX3d& x = ext_.rest;
+  const Eigen::RowVector3d centroid = x.topRows(n).colwise().mean();
+  const double size = std::max((x.topRows(n).rowwise() - centroid).rowwise().norm().maxCoeff(), 1e-300);
+  auto rigid = [&](int v, int c) {  // the six basis motions' component c at vertex v
+    const Eigen::Vector3d p = (x.row(v) - centroid).transpose() / size;
+    Eigen::Matrix<double, 6, 1> r;
+    for (int i = 0; i < 3; ++i) {
+      r(i) = i == c ? 1.0 : 0.0;
+      r(3 + i) = Eigen::Vector3d::Unit(i).cross(p)(c);
+    }
+    return r;
+  };
+  Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int v = 0; v < ext_.num_vertices(); ++v)
+    for (int c = 0; c < 3; ++c) {
+      if (v < n && dofs_.is_free(v, c)) continue;
+      Eigen::Matrix<double, 6, 1> residual = rigid(v, c);
+      for (const auto& [m, w] : dofs_.combination(v, c)) residual -= w * rigid(m, c);
+      gram += residual * residual.transpose();
+    }
+  std::vector<std::string> out;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(gram);
+  const double scale = std::max(1.0, eig.eigenvalues().maxCoeff());
+  const char* axes = "xyz";
+  for (int k = 0; k < 6; ++k) {
+    if (eig.eigenvalues()(k) > 1e-9 * scale) continue;
+    const Eigen::Matrix<double, 6, 1> mode = eig.eigenvectors().col(k);
+    std::ostringstream s;
+    bool first = true;
+    for (int i = 0; i < 6; ++i) {
+      if (std::abs(mode(i)) < 1e-6) continue;
+      s << (first ? "" : " + ") << (i < 3 ? "translation along " : "rotation about ") << axes[i % 3];
+      first = false;
+    }
+    out.push_back(s.str());
   }
   return out;
 }

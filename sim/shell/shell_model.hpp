@@ -19,6 +19,7 @@
 #include <Eigen/SparseCore>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace clothsim {
@@ -48,6 +49,10 @@ class ShellModel {
   Eigen::SparseMatrix<double> stiffness() const;
   // Element stiffness folded onto the element's real vertices (3·#real square).
   Eigen::MatrixXd folded_element_stiffness(int e) const;
+  // Rigid motions (translations, infinitesimal rotations about the centroid) that the boundary
+  // conditions leave free, described in words (e.g. "translation along y"); empty when the
+  // structure is supported. A non-empty answer means the stiffness is singular.
+  std::vector<std::string> unrestrained_rigid_motions() const;
   // Number of colour groups used for parallel assembly (elements of one group share no vertex).
   int num_colors() const { return static_cast<int>(colors_.size()); }
 

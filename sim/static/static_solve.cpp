@@ -47,6 +47,13 @@ StaticResult solve_static(const StaticProblem& problem) {
 
   const auto t0 = std::chrono::steady_clock::now();
   const ShellModel model(problem.mesh, problem.material, problem.boundary, problem.quadrature);
+  if (const std::vector<std::string> free_motions = model.unrestrained_rigid_motions(); !free_motions.empty()) {
+    std::string list;
+    for (const std::string& m : free_motions) list += (list.empty() ? "" : "; ") + m;
+    throw std::runtime_error("the boundary conditions leave " + std::to_string(free_motions.size()) +
+                             " rigid motion(s) free, so the structure can move without deforming (" + list +
+                             "): fix more displacement components");
+  }
   const Eigen::SparseMatrix<double> k = model.stiffness();
   Eigen::VectorXd f = model.area_load(problem.surface_load + problem.material.areal_density * problem.gravity);
   for (const PointLoad& p : problem.point_loads) f += model.point_load(p.vertex, p.force);
