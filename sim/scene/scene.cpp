@@ -425,8 +425,11 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
         bc.fix[axis] = true;
       }
     }
-    if (const Json* rotation = r.find(item, "rotation"))
-      bc.clamped = r.choice(*rotation, join_key(path, "rotation"), {"free", "clamped"}) == "clamped";
+    if (const Json* rotation = r.find(item, "rotation")) {
+      const std::string kind = r.choice(*rotation, join_key(path, "rotation"), {"free", "clamped", "symmetry"});
+      bc.clamped = kind == "clamped";
+      bc.symmetric = kind == "symmetry";
+    }
 
     bc.vertices = select_box(mesh.vertices, lo, hi);
     if (bc.vertices.empty())

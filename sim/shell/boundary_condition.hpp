@@ -11,6 +11,9 @@ struct BoundaryCondition {
   std::array<bool, 3> fix{true, true, true};  // displacement components held at zero (x, y, z)
   bool clamped = false;                       // false: hinged (rotation free); true: slope held
                                               // across border edges whose two ends are selected
+  bool symmetric = false;                     // plane of symmetry: across border edges whose two
+                                              // ends are selected, fixed components are mirrored
+                                              // oddly and free components evenly
 };
 
 }  // namespace clothsim

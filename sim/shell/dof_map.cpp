@@ -1,6 +1,7 @@
 #include "sim/shell/dof_map.hpp"
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include <limits>
@@ -22,64 +23,116 @@ Combination merged(const std::vector<std::pair<const Combination*, double>>& par
 
 }  // namespace
 
+namespace {
+
+// Area-weighted normals of the real vertices (from the real triangles).
+std::vector<Eigen::Vector3d> vertex_normals(const ExtendedMesh& ext) {
+  std::vector<Eigen::Vector3d> normals(ext.num_real, Eigen::Vector3d::Zero());
+  for (int t = 0; t < ext.num_real_triangles; ++t) {
+    const Triangle& tri = ext.triangles[t];
+    const Eigen::Vector3d x0 = ext.rest.row(tri[0]), x1 = ext.rest.row(tri[1]), x2 = ext.rest.row(tri[2]);
+    const Eigen::Vector3d n = (x1 - x0).cross(x2 - x0);
+    for (int v : tri) normals[v] += n;
+  }
+  for (Eigen::Vector3d& n : normals) n.normalize();
+  return normals;
+}
+
+}  // namespace
+
 DofMap::DofMap(const ExtendedMesh& ext, const std::vector<BoundaryCondition>& conditions)
     : num_real_(ext.num_real), status_(3 * ext.num_real, DofStatus::free), combos_(3 * ext.num_vertices()) {
   const Topology& top = ext.topology;
   const int n = ext.num_real;
-  // Clamped border edges per component: ghost k is clamped in component c when both ends of its
-  // border edge are selected by one clamped condition that fixes c.
-  std::vector<std::array<bool, 3>> ghost_clamped(ext.ghosts.size(), {false, false, false});
-  std::vector<std::array<bool, 3>> tied(n, {false, false, false});  // border vertex on a clamped edge
+  const std::vector<Eigen::Vector3d> normal = vertex_normals(ext);
+  std::vector<bool> ghost_clamped(ext.ghosts.size(), false), ghost_symmetric(ext.ghosts.size(), false);
+  std::vector<std::array<bool, 3>> clamp_fix(n, {false, false, false});  // border vertex on a clamped edge
+  std::vector<bool> on_clamped_edge(n, false);
   for (const BoundaryCondition& bc : conditions) {
     std::vector<bool> selected(n, false);
     for (int v : bc.vertices) selected[v] = true;
     for (int v : bc.vertices)
       for (int c = 0; c < 3; ++c)
         if (bc.fix[c]) status_[3 * v + c] = DofStatus::fixed;
+    if (bc.symmetric)
+      for (size_t k = 0; k < ext.ghosts.size(); ++k)
+        if (selected[ext.ghosts[k].a] && selected[ext.ghosts[k].b]) ghost_symmetric[k] = true;
     if (!bc.clamped) continue;
     for (size_t k = 0; k < ext.ghosts.size(); ++k) {
       const GhostVertex& g = ext.ghosts[k];
       if (!selected[g.a] || !selected[g.b]) continue;
-      for (int c = 0; c < 3; ++c)
-        if (bc.fix[c]) ghost_clamped[k][c] = tied[g.a][c] = tied[g.b][c] = true;
+      ghost_clamped[k] = true;
+      for (int v : {g.a, g.b}) {
+        on_clamped_edge[v] = true;
+        for (int c = 0; c < 3; ++c) clamp_fix[v][c] = clamp_fix[v][c] || bc.fix[c];
+      }
     }
   }
   // Free components stand for themselves.
   for (int v = 0; v < n; ++v)
     for (int c = 0; c < 3; ++c)
       if (status_[3 * v + c] == DofStatus::free) {
-        combos_[3 * v + c] = {{v, 1.0}};
+        combos_[3 * v + c] = {{3 * v + c, 1.0}};
         ++num_free_;
       }
-  // Tied border vertices: u_b = −½ mean of the real neighbours that are not on a border.
+  // Tied border vertices on clamped edges: N·u_b = −½ mean(N·u_m) over interior neighbours,
+  // when N lies in the span of the fixed components.
   std::vector<bool> border(n, false);
   for (const GhostVertex& g : ext.ghosts) border[g.a] = border[g.b] = true;
-  for (int v = 0; v < n; ++v)
+  for (int v = 0; v < n; ++v) {
+    if (!on_clamped_edge[v]) continue;
+    const Eigen::Vector3d& nv = normal[v];
+    double in_span = 0.0;
+    for (int c = 0; c < 3; ++c)
+      if (clamp_fix[v][c] && status_[3 * v + c] == DofStatus::fixed) in_span += nv(c) * nv(c);
+    if (in_span < 0.99) continue;
+    std::vector<int> interior;
+    for (int m : top.ring(v))
+      if (m < n && !border[m]) interior.push_back(m);
+    if (interior.empty()) continue;
+    const double scale = -0.5 / static_cast<double>(interior.size());
     for (int c = 0; c < 3; ++c) {
-      if (!tied[v][c]) continue;
+      if (!clamp_fix[v][c] || status_[3 * v + c] != DofStatus::fixed) continue;
       std::vector<std::pair<const Combination*, double>> parts;
-      for (int m : top.ring(v))
-        if (m < n && !border[m]) parts.emplace_back(&combos_[3 * m + c], 0.0);
-      for (auto& part : parts) part.second = -0.5 / static_cast<double>(parts.size());
-      status_[3 * v + c] = parts.empty() ? DofStatus::fixed : DofStatus::dependent;
+      for (int m : interior)
+        for (int d = 0; d < 3; ++d) parts.emplace_back(&combos_[3 * m + d], scale * nv(c) * nv(d));
       combos_[3 * v + c] = merged(parts);
+      status_[3 * v + c] = DofStatus::dependent;
     }
+  }
   // Ghosts, from the (now final) real combinations.
   for (size_t k = 0; k < ext.ghosts.size(); ++k) {
     const GhostVertex& g = ext.ghosts[k];
     const int id = n + static_cast<int>(k);
     const GhostMirror mirror = ghost_mirror(ext, static_cast<int>(k));
+    // Component-wise base rule: free edge or odd reflection.
+    std::array<Combination, 3> base;
     for (int c = 0; c < 3; ++c) {
       std::vector<std::pair<const Combination*, double>> parts;
-      if (ghost_clamped[k][c]) {  // even reflection: u_g = u(mirror point)
-        for (int i = 0; i < 3; ++i) parts.emplace_back(&combos_[3 * mirror.vertices[i] + c], mirror.weights[i]);
-      } else if (status_[3 * g.a + c] == DofStatus::fixed && status_[3 * g.b + c] == DofStatus::fixed) {
-        // hinged: odd reflection about the edge, u_g = 2 u(edge point) − u(mirror point)
+      if (status_[3 * g.a + c] != DofStatus::free && status_[3 * g.b + c] != DofStatus::free) {
         parts.emplace_back(&combos_[3 * g.a + c], 2.0 * (1.0 - mirror.edge_parameter));
         parts.emplace_back(&combos_[3 * g.b + c], 2.0 * mirror.edge_parameter);
         for (int i = 0; i < 3; ++i) parts.emplace_back(&combos_[3 * mirror.vertices[i] + c], -mirror.weights[i]);
-      } else {  // free edge (Cirak et al. 2000): u_g = u_a + u_b − u_c
+      } else if (ghost_symmetric[k]) {  // even reflection of a free component
+        for (int i = 0; i < 3; ++i) parts.emplace_back(&combos_[3 * mirror.vertices[i] + c], mirror.weights[i]);
+      } else {
         parts = {{&combos_[3 * g.a + c], 1.0}, {&combos_[3 * g.b + c], 1.0}, {&combos_[3 * g.c + c], -1.0}};
+      }
+      base[c] = merged(parts);
+    }
+    if (!ghost_clamped[k]) {
+      for (int c = 0; c < 3; ++c) combos_[3 * id + c] = std::move(base[c]);
+      continue;
+    }
+    // Clamped: u_g = N Nᵀ u(g') + (I − N Nᵀ) base.
+    const Eigen::Vector3d edge_normal = (normal[g.a] + normal[g.b]).normalized();
+    for (int c = 0; c < 3; ++c) {
+      std::vector<std::pair<const Combination*, double>> parts = {{&base[c], 1.0}};
+      for (int d = 0; d < 3; ++d) {
+        const double nn = edge_normal(c) * edge_normal(d);
+        if (nn == 0.0) continue;
+        for (int i = 0; i < 3; ++i) parts.emplace_back(&combos_[3 * mirror.vertices[i] + d], nn * mirror.weights[i]);
+        parts.emplace_back(&base[d], -nn);
       }
       combos_[3 * id + c] = merged(parts);
     }
@@ -124,7 +177,7 @@ bool DofMap::is_identity(int vertex) const {
   if (vertex >= num_real_) return false;
   for (int c = 0; c < 3; ++c) {
     const Combination& combo = combos_[3 * vertex + c];
-    if (combo.size() != 1 || combo[0].first != vertex || combo[0].second != 1.0) return false;
+    if (combo.size() != 1 || combo[0].first != 3 * vertex + c || combo[0].second != 1.0) return false;
   }
   return true;
 }
@@ -134,7 +187,7 @@ Eigen::MatrixX3d DofMap::expand(const Eigen::MatrixX3d& real) const {
   Eigen::MatrixX3d out = Eigen::MatrixX3d::Zero(total, 3);
   for (Eigen::Index v = 0; v < total; ++v)
     for (int c = 0; c < 3; ++c)
-      for (const auto& [r, w] : combos_[3 * v + c]) out(v, c) += w * real(r, c);
+      for (const auto& [dof, w] : combos_[3 * v + c]) out(v, c) += w * real(dof / 3, dof % 3);
   return out;
 }
 

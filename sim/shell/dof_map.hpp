@@ -2,17 +2,22 @@
 // free real displacement components (paper §4.4: ghost vertices and boundary conditions are
 // folded into the element matrices, so the system stays symmetric; formulas.md §6).
 //
-// All rules act per Cartesian component c ∈ {x, y, z}:
-//  - a free real component is itself; a fixed one is zero;
-//  - ghost g of a free border edge (a, b) opposite c: u_g = u_a + u_b − u_c (Cirak et al. 2000);
-//  - hinged edge (u_a, u_b fixed): odd reflection about the edge, u_g = 2 u(e) − u(g'), where e
-//    is the foot of g on the edge and g' the mirror image of g across it, u(g') interpolated
-//    linearly in the real triangle that holds g' (zero normal curvature at the edge);
-//  - on a clamped border edge (both ends selected by a clamped condition, component fixed):
-//    u_g = u(g') (even reflection) and each selected border vertex b is tied to its interior
-//    neighbours m, u_b = −½ mean(u_m), which holds the limit surface's value and slope at zero
-//    for data constant along a straight edge (a border vertex with no interior neighbour is
-//    fixed instead).
+// Rules (u(g') is the displacement interpolated at the mirror image g' of ghost g across its
+// border edge (a, b), e its foot on the edge, c the real vertex opposite the edge):
+//  - free components stand for themselves; fixed ones are zero;
+//  - free border edge: u_g = u_a + u_b − u_c (Cirak et al. 2000), component by component;
+//  - a component fixed at both a and b (hinged): odd reflection u_g = 2 u(e) − u(g'), which
+//    gives zero normal curvature at the edge;
+//  - clamped edge (a and b selected by one clamped condition): the part of u_g along the
+//    surface normal N at the edge is the even reflection N·u(g') (zero slope across the edge);
+//    the tangential part follows the two rules above. A selected border vertex b whose normal
+//    lies in the span of the fixed components is tied to its interior (non-border) neighbours m,
+//    N·u_b = −½ mean(N·u_m), which holds the limit surface's value and slope at zero for data
+//    constant along a straight edge (no interior neighbour: b stays fixed).
+//  - symmetry edge (a and b selected by one symmetric condition): fixed components mirror oddly
+//    (above), free components evenly, u_g = u(g'): the exact mirror image across a plane of
+//    symmetry normal to a fixed Cartesian axis.
+// For a flat plate (N = z) clamped gives the even rule for w and the odd rule in the plane.
 #pragma once
 
 #include "sim/shell/boundary_condition.hpp"
@@ -36,7 +41,7 @@ GhostMirror ghost_mirror(const ExtendedMesh& ext, int ghost);
 
 enum class DofStatus : unsigned char { free, fixed, dependent };
 
-// Σ weight · u[vertex] over free real components of the same Cartesian component.
+// Σ weight · u[dof] over free real components, dof = 3·vertex + component.
 using Combination = std::vector<std::pair<int, double>>;
 
 class DofMap {

@@ -33,7 +33,7 @@ ExtendedMesh build_ghost_layer(const TriMesh& mesh) {
   std::vector<GhostVertex> ghosts;
   std::vector<Triangle> triangles;
   Topology top = make_extended(mesh, ghosts, triangles);
-  ExtendedMesh ext{mesh.num_vertices(), std::move(ghosts), std::move(triangles), std::move(top), {}};
+  ExtendedMesh ext{mesh.num_vertices(), std::move(ghosts), std::move(triangles), mesh.num_triangles(), std::move(top), {}};
   ext.rest.resize(ext.num_vertices(), 3);
   ext.rest.topRows(ext.num_real) = mesh.vertices;
   for (size_t k = 0; k < ext.ghosts.size(); ++k) {

@@ -26,6 +26,7 @@ struct ExtendedMesh {
   int num_real = 0;                 // real vertices keep their ids 0 .. num_real − 1
   std::vector<GhostVertex> ghosts;  // ghost k has id num_real + k
   std::vector<Triangle> triangles;  // real triangles first, then ghost triangles
+  int num_real_triangles = 0;
   Topology topology;                // of the extended mesh
   Eigen::MatrixX3d rest;            // rest positions of real and ghost vertices [m]
 

@@ -38,20 +38,19 @@ ShellElement make_element(const ExtendedMesh& ext, const DofMap& dofs, const Tri
   }
   for (int p : el.patch)
     for (int c = 0; c < 3; ++c)
-      for (const auto& [r, w] : dofs.combination(p, c)) {
+      for (const auto& [dof, w] : dofs.combination(p, c)) {
         (void)w;
-        el.real.push_back(r);
+        el.real.push_back(dof / 3);
       }
   std::sort(el.real.begin(), el.real.end());
   el.real.erase(std::unique(el.real.begin(), el.real.end()), el.real.end());
   std::map<int, Eigen::Index> col;
   for (size_t i = 0; i < el.real.size(); ++i) col[el.real[i]] = static_cast<Eigen::Index>(i);
   const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size()), nr = static_cast<Eigen::Index>(el.real.size());
-  for (int c = 0; c < 3; ++c) {
-    el.fold[c] = Eigen::MatrixXd::Zero(np, nr);
-    for (Eigen::Index p = 0; p < np; ++p)
-      for (const auto& [r, w] : dofs.combination(el.patch[p], c)) el.fold[c](p, col.at(r)) += w;
-  }
+  el.fold = Eigen::MatrixXd::Zero(3 * np, 3 * nr);
+  for (Eigen::Index p = 0; p < np; ++p)
+    for (int c = 0; c < 3; ++c)
+      for (const auto& [dof, w] : dofs.combination(el.patch[p], c)) el.fold(3 * p + c, 3 * col.at(dof / 3) + dof % 3) += w;
   return el;
 }
 
@@ -157,12 +156,7 @@ Eigen::MatrixXd ShellModel::folded_element_stiffness(int e) const {
   const ShellElement& el = elements_[e];
   const ElementMatrix k = element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_);
   if (el.identity) return k;
-  const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size()), nr = static_cast<Eigen::Index>(el.real.size());
-  Eigen::MatrixXd t = Eigen::MatrixXd::Zero(3 * np, 3 * nr);
-  for (int c = 0; c < 3; ++c)
-    for (Eigen::Index p = 0; p < np; ++p)
-      for (Eigen::Index r = 0; r < nr; ++r) t(3 * p + c, 3 * r + c) = el.fold[c](p, r);
-  return t.transpose() * k * t;
+  return el.fold.transpose() * k * el.fold;
 }
 
 Eigen::SparseMatrix<double> ShellModel::stiffness() const {
@@ -190,7 +184,7 @@ Eigen::SparseMatrix<double> ShellModel::stiffness() const {
 void ShellModel::scatter_vector(const ShellElement& el, const Eigen::VectorXd& local, Eigen::VectorXd& global) const {
   for (size_t p = 0; p < el.patch.size(); ++p)
     for (int c = 0; c < 3; ++c)
-      for (const auto& [r, w] : dofs_.combination(el.patch[p], c)) global(3 * r + c) += w * local(3 * static_cast<Eigen::Index>(p) + c);
+      for (const auto& [dof, w] : dofs_.combination(el.patch[p], c)) global(dof) += w * local(3 * static_cast<Eigen::Index>(p) + c);
 }
 
 Eigen::VectorXd ShellModel::area_load(const Eigen::Vector3d& q) const {
@@ -215,7 +209,7 @@ Eigen::VectorXd ShellModel::point_load(int v, const Eigen::Vector3d& force) cons
   const double w = limit_neighbour_weight(valence);
   auto add = [&](int vertex, double weight) {
     for (int c = 0; c < 3; ++c)
-      for (const auto& [r, cw] : dofs_.combination(vertex, c)) f(3 * r + c) += weight * cw * force(c);
+      for (const auto& [dof, cw] : dofs_.combination(vertex, c)) f(dof) += weight * cw * force(c);
   };
   add(v, 1.0 - valence * w);
   for (int r : ring) add(r, w);
@@ -258,7 +252,7 @@ std::vector<std::string> ShellModel::unrestrained_rigid_motions() const {
     for (int c = 0; c < 3; ++c) {
       if (v < n && dofs_.is_free(v, c)) continue;
       Eigen::Matrix<double, 6, 1> residual = rigid(v, c);
-      for (const auto& [m, w] : dofs_.combination(v, c)) residual -= w * rigid(m, c);
+      for (const auto& [dof, w] : dofs_.combination(v, c)) residual -= w * rigid(dof / 3, dof % 3);
       gram += residual * residual.transpose();
     }
   std::vector<std::string> out;

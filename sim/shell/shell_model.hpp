@@ -31,7 +31,7 @@ struct ShellElement {
   std::vector<double> weights;      // quadrature weights (sum 1/2)
   std::vector<int> real;            // real vertices the patch's displacements depend on
   bool identity = false;            // patch == real and every component free and itself
-  std::array<Eigen::MatrixXd, 3> fold;  // per component: #patch × #real weights (when !identity)
+  Eigen::MatrixXd fold;             // 3·#patch × 3·#real weights (when !identity)
 };
 
 class ShellModel {

@@ -236,7 +236,7 @@ TEST_F(SceneLoader, BoundaryErrors) {
   EXPECT_TRUE(contains(bc(R"({"select": {"box": [[-1, -1, -1], [1, 1, 1]]}, "fix": ["x", "x"]})"),
                        expected("boundary[0].fix[1]: duplicate component \"x\"")));
   EXPECT_TRUE(contains(bc(R"({"select": {"box": [[-1, -1, -1], [1, 1, 1]]}, "rotation": "fixed"})"),
-                       expected("boundary[0].rotation: unknown value \"fixed\" (allowed: \"free\", \"clamped\")")));
+                       expected("boundary[0].rotation: unknown value \"fixed\" (allowed: \"free\", \"clamped\", \"symmetry\")")));
   EXPECT_TRUE(contains(bc(R"({"fix": ["x"]})"), expected("boundary[0].select: required key is missing")));
   EXPECT_TRUE(contains(bc(R"({"select": {"box": [[2, 2, 2], [3, 3, 3]]}})"),
                        expected("boundary[0].select.box: selects no vertex")));
