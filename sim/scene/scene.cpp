@@ -449,9 +449,10 @@ std::string describe_snap(const Eigen::MatrixX3d& vertices, int v, const Eigen::
 
 void read_loads(const Reader& r, const Json* j, StaticProblem& problem, const LogFn& log) {
   if (j == nullptr) return;
-  r.check_object(*j, "loads", {"gravity", "surface_load", "point_loads"});
+  r.check_object(*j, "loads", {"gravity", "surface_load", "pressure", "point_loads"});
   if (const Json* g = r.find(*j, "gravity")) problem.gravity = r.vec3(*g, "loads.gravity");
   if (const Json* s = r.find(*j, "surface_load")) problem.surface_load = r.vec3(*s, "loads.surface_load");
+  if (const Json* s = r.find(*j, "pressure")) problem.pressure = r.number(*s, "loads.pressure");
   if (const Json* p = r.find(*j, "point_loads")) {
     r.array(*p, "loads.point_loads");
     for (std::size_t i = 0; i < p->size(); ++i) {

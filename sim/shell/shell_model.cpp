@@ -188,14 +188,24 @@ void ShellModel::scatter_vector(const ShellElement& el, const Eigen::VectorXd& l
 }
 
 Eigen::VectorXd ShellModel::area_load(const Eigen::Vector3d& q) const {
+  return surface_traction_load([&](const SurfacePoint&) { return q; });
+}
+
+Eigen::VectorXd ShellModel::pressure_load(double p) const {
+  return surface_traction_load([&](const SurfacePoint& s) -> Eigen::Vector3d { return p * s.a3; });
+}
+
+Eigen::VectorXd ShellModel::surface_traction_load(
+    const std::function<Eigen::Vector3d(const SurfacePoint&)>& traction) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * num_vertices());
   for (const ShellElement& el : elements_) {
     const Eigen::MatrixX3d x = patch_rows(ext_.rest, el.patch);
     Eigen::VectorXd local = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(el.patch.size()));
     for (size_t k = 0; k < el.basis.size(); ++k) {
-      const double scale = el.weights[k] * surface_point(el.basis[k], x).j;
+      const SurfacePoint s = surface_point(el.basis[k], x);
+      const Eigen::Vector3d t = (el.weights[k] * s.j) * traction(s);
       for (Eigen::Index p = 0; p < static_cast<Eigen::Index>(el.patch.size()); ++p)
-        local.segment<3>(3 * p) += scale * el.basis[k](kValue, p) * q;
+        local.segment<3>(3 * p) += el.basis[k](kValue, p) * t;
     }
     scatter_vector(el, local, f);
   }

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -58,6 +59,8 @@ class ShellModel {
 
   // Consistent load of a force per unit reference area q [N/m²]: f_I = ∫ N_I q dA.
   Eigen::VectorXd area_load(const Eigen::Vector3d& q) const;
+  // Pressure p [N/m²] along the reference surface's unit normal a₃: f_I = ∫ N_I p a₃ dA.
+  Eigen::VectorXd pressure_load(double p) const;
   // A force [N] at the limit point of real vertex v, spread with the limit-mask weights.
   Eigen::VectorXd point_load(int v, const Eigen::Vector3d& force) const;
 
@@ -68,6 +71,8 @@ class ShellModel {
  private:
   // Folds a patch-local vector (3·#patch) into the global vector.
   void scatter_vector(const ShellElement& el, const Eigen::VectorXd& local, Eigen::VectorXd& global) const;
+  // ∫ N_I t(x) dA for a traction t [N/m²] given at each quadrature point's reference geometry.
+  Eigen::VectorXd surface_traction_load(const std::function<Eigen::Vector3d(const SurfacePoint&)>& traction) const;
   void build_pattern();
   void build_colors();
   template <class Matrix>

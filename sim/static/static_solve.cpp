@@ -56,6 +56,7 @@ StaticResult solve_static(const StaticProblem& problem) {
   }
   const Eigen::SparseMatrix<double> k = model.stiffness();
   Eigen::VectorXd f = model.area_load(problem.surface_load + problem.material.areal_density * problem.gravity);
+  if (problem.pressure != 0.0) f += model.pressure_load(problem.pressure);
   for (const PointLoad& p : problem.point_loads) f += model.point_load(p.vertex, p.force);
   StaticResult result;
   result.assemble_seconds = seconds_since(t0);

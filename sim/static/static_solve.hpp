@@ -28,6 +28,7 @@ struct StaticProblem {
   std::vector<BoundaryCondition> boundary;
   Eigen::Vector3d gravity = Eigen::Vector3d::Zero();       // [m/s²], mass-proportional load
   Eigen::Vector3d surface_load = Eigen::Vector3d::Zero();  // [N/m² of reference area]
+  double pressure = 0.0;  // [N/m²] along the reference surface normal (the triangles' orientation)
   std::vector<PointLoad> point_loads;
   Quadrature quadrature = Quadrature::one_point;
 };

@@ -5,7 +5,6 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/shell/shell_model.hpp"
 #include "sim/static/static_solve.hpp"
-#include "sim/subdivision/box_spline.hpp"
 #include "sim/solver/direct_solver.hpp"
 
 #include <gtest/gtest.h>
@@ -31,20 +30,7 @@ EdgeProfile pressurised_cylinder(bool clamped) {
   rims.clamped = clamped;
   const ShellModel model(mesh, material, {rims}, Quadrature::three_point);
 
-  // Pressure load f_I = ∫ N_I p a₃ dA, folded like the model's own loads (all rules conserve
-  // the patch vector through the DOF map combinations).
-  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * mesh.num_vertices());
-  for (const ShellElement& el : model.elements()) {
-    Eigen::MatrixX3d x(static_cast<Eigen::Index>(el.patch.size()), 3);
-    for (size_t i = 0; i < el.patch.size(); ++i) x.row(static_cast<Eigen::Index>(i)) = model.extended().rest.row(el.patch[i]);
-    for (size_t q = 0; q < el.basis.size(); ++q) {
-      const SurfacePoint s = surface_point(el.basis[q], x);
-      for (size_t p = 0; p < el.patch.size(); ++p)
-        for (int c = 0; c < 3; ++c)
-          for (const auto& [dof, w] : model.dofs().combination(el.patch[p], c))
-            f(dof) += w * el.weights[q] * s.j * el.basis[q](kValue, static_cast<Eigen::Index>(p)) * pressure * s.a3(c);
-    }
-  }
+  const Eigen::VectorXd f = model.pressure_load(pressure);  // normals point outwards
   DirectSolver solver;
   EXPECT_TRUE(solver.factorize(model.stiffness()));
   const Eigen::VectorXd u = solver.solve(f);
