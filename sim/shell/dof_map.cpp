@@ -68,13 +68,12 @@ DofMap::DofMap(const ExtendedMesh& ext, const std::vector<BoundaryCondition>& co
       }
     }
   }
-  // Free components stand for themselves.
+  // Free and fixed (prescribed) components stand for themselves.
   for (int v = 0; v < n; ++v)
-    for (int c = 0; c < 3; ++c)
-      if (status_[3 * v + c] == DofStatus::free) {
-        combos_[3 * v + c] = {{3 * v + c, 1.0}};
-        ++num_free_;
-      }
+    for (int c = 0; c < 3; ++c) {
+      combos_[3 * v + c] = {{3 * v + c, 1.0}};
+      if (status_[3 * v + c] == DofStatus::free) ++num_free_;
+    }
   // Tied border vertices on clamped edges: N·u_b = −½ mean(N·u_m) over interior neighbours,
   // when N lies in the span of the fixed components.
   std::vector<bool> border(n, false);

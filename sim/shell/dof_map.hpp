@@ -4,7 +4,7 @@
 //
 // Rules (u(g') is the displacement interpolated at the mirror image g' of ghost g across its
 // border edge (a, b), e its foot on the edge, c the real vertex opposite the edge):
-//  - free components stand for themselves; fixed ones are zero;
+//  - free and fixed (prescribed) components stand for themselves;
 //  - free border edge: u_g = u_a + u_b − u_c (Cirak et al. 2000), component by component;
 //  - a component fixed at both a and b (hinged): odd reflection u_g = 2 u(e) − u(g'), which
 //    gives zero normal curvature at the edge;
@@ -41,7 +41,9 @@ GhostMirror ghost_mirror(const ExtendedMesh& ext, int ghost);
 
 enum class DofStatus : unsigned char { free, fixed, dependent };
 
-// Σ weight · u[dof] over free real components, dof = 3·vertex + component.
+// Σ weight · u[dof] over free and fixed real components, dof = 3·vertex + component (fixed
+// components carry their prescribed displacement: zero in a static analysis, a scripted motion
+// in a dynamic one).
 using Combination = std::vector<std::pair<int, double>>;
 
 class DofMap {
@@ -53,11 +55,11 @@ class DofMap {
   DofStatus status(int real_vertex, int component) const { return status_[3 * real_vertex + component]; }
   bool is_free(int real_vertex, int component) const { return status(real_vertex, component) == DofStatus::free; }
   const Combination& combination(int vertex, int component) const { return combos_[3 * vertex + component]; }
-  // True when every component of `vertex` is a free real component standing for itself.
+  // True when every component of `vertex` is a real component standing for itself.
   bool is_identity(int vertex) const;
 
-  // Displacements of all extended vertices (#ext × 3) from real displacements (#real × 3; only
-  // the free components are read).
+  // Displacements of all extended vertices (#ext × 3) from real displacements (#real × 3; the
+  // free and fixed components are read, dependent ones are derived).
   Eigen::MatrixX3d expand(const Eigen::MatrixX3d& real) const;
 
  private:

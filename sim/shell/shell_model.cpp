@@ -175,10 +175,22 @@ Eigen::SparseMatrix<double> ShellModel::stiffness() const {
           scatter_matrix(e, folded_element_stiffness(e), values);
       }
     });
-  for (int v = 0; v < num_vertices(); ++v)
-    for (int c = 0; c < 3; ++c)
-      if (!dofs_.is_free(v, c)) k.coeffRef(3 * v + c, 3 * v + c) = 1.0;
   return k;
+}
+
+void ShellModel::restrict_to_free(Eigen::SparseMatrix<double>& k) const {
+  for (Eigen::Index col = 0; col < k.outerSize(); ++col) {
+    const bool col_free = dofs_.is_free(static_cast<int>(col / 3), static_cast<int>(col % 3));
+    for (Eigen::SparseMatrix<double>::InnerIterator it(k, col); it; ++it) {
+      const bool row_free = dofs_.is_free(static_cast<int>(it.row() / 3), static_cast<int>(it.row() % 3));
+      if (!col_free || !row_free) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+    }
+  }
+}
+
+void ShellModel::restrict_to_free(Eigen::VectorXd& f) const {
+  for (Eigen::Index i = 0; i < f.size(); ++i)
+    if (!dofs_.is_free(static_cast<int>(i / 3), static_cast<int>(i % 3))) f(i) = 0.0;
 }
 
 void ShellModel::scatter_vector(const ShellElement& el, const Eigen::VectorXd& local, Eigen::VectorXd& global) const {
@@ -262,7 +274,9 @@ std::vector<std::string> ShellModel::unrestrained_rigid_motions() const {
     for (int c = 0; c < 3; ++c) {
       if (v < n && dofs_.is_free(v, c)) continue;
       Eigen::Matrix<double, 6, 1> residual = rigid(v, c);
-      for (const auto& [dof, w] : dofs_.combination(v, c)) residual -= w * rigid(dof / 3, dof % 3);
+      if (v >= n || dofs_.status(v, c) == DofStatus::dependent)
+        for (const auto& [dof, w] : dofs_.combination(v, c))
+          if (dofs_.is_free(dof / 3, dof % 3)) residual -= w * rigid(dof / 3, dof % 3);
       gram += residual * residual.transpose();
     }
   std::vector<std::string> out;

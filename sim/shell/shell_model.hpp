@@ -3,8 +3,9 @@
 // rest-state element stiffness, and sparse assembly over the real vertices (paper eqs. 26–27).
 //
 // Global vectors are flat over the real control vertices, [x0 y0 z0 x1 ...] (3·#V); matrices are
-// 3·#V square. Components that are not free (fixed, or tied by a clamped border) have no
-// coupling: their rows and columns hold only a unit diagonal, and their load entries are zero.
+// 3·#V square. Fixed components couple like free ones (they may carry prescribed motion);
+// components tied by a clamped border have empty rows and columns. restrict_to_free() turns a
+// matrix and load into the system for the free components alone.
 #pragma once
 
 #include "sim/mesh/mesh.hpp"
@@ -46,8 +47,13 @@ class ShellModel {
   const std::vector<ShellElement>& elements() const { return elements_; }
   const ShellMaterial& material() const { return material_; }
 
-  // Rest-state stiffness over the real vertices (3·#V square, symmetric).
+  // Rest-state stiffness over the real vertices (3·#V square, symmetric), including the rows
+  // and columns of fixed components.
   Eigen::SparseMatrix<double> stiffness() const;
+  // Keeps only the coupling between free components: rows and columns of the others become a
+  // unit diagonal (zero prescribed displacement), load entries zero.
+  void restrict_to_free(Eigen::SparseMatrix<double>& k) const;
+  void restrict_to_free(Eigen::VectorXd& f) const;
   // Element stiffness folded onto the element's real vertices (3·#real square).
   Eigen::MatrixXd folded_element_stiffness(int e) const;
   // Rigid motions (translations, infinitesimal rotations about the centroid) that the boundary

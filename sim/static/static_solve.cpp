@@ -54,10 +54,12 @@ StaticResult solve_static(const StaticProblem& problem) {
                              " rigid motion(s) free, so the structure can move without deforming (" + list +
                              "): fix more displacement components");
   }
-  const Eigen::SparseMatrix<double> k = model.stiffness();
+  Eigen::SparseMatrix<double> k = model.stiffness();
+  model.restrict_to_free(k);
   Eigen::VectorXd f = model.area_load(problem.surface_load + problem.material.areal_density * problem.gravity);
   if (problem.pressure != 0.0) f += model.pressure_load(problem.pressure);
   for (const PointLoad& p : problem.point_loads) f += model.point_load(p.vertex, p.force);
+  model.restrict_to_free(f);
   StaticResult result;
   result.assemble_seconds = seconds_since(t0);
   result.dofs = model.dofs().num_free();

@@ -30,9 +30,12 @@ EdgeProfile pressurised_cylinder(bool clamped) {
   rims.clamped = clamped;
   const ShellModel model(mesh, material, {rims}, Quadrature::three_point);
 
-  const Eigen::VectorXd f = model.pressure_load(pressure);  // normals point outwards
+  Eigen::VectorXd f = model.pressure_load(pressure);  // normals point outwards
+  Eigen::SparseMatrix<double> k = model.stiffness();
+  model.restrict_to_free(k);
+  model.restrict_to_free(f);
   DirectSolver solver;
-  EXPECT_TRUE(solver.factorize(model.stiffness()));
+  EXPECT_TRUE(solver.factorize(k));
   const Eigen::VectorXd u = solver.solve(f);
   const Eigen::MatrixX3d real = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(u.data(), mesh.num_vertices(), 3);
   const Eigen::MatrixX3d ext_u = model.dofs().expand(real);
