@@ -1,6 +1,8 @@
 // Boundary conditions on control vertices (paper §4.4, formulas.md §6).
 #pragma once
 
+#include "sim/shell/motion.hpp"
+
 #include <array>
 #include <vector>
 
@@ -14,6 +16,8 @@ struct BoundaryCondition {
   bool symmetric = false;                     // plane of symmetry: across border edges whose two
                                               // ends are selected, fixed components are mirrored
                                               // oddly and free components evenly
+  std::vector<Motion> motion;                 // dynamic analysis: the fixed components follow
+                                              // this chain instead of staying at rest
 };
 
 }  // namespace clothsim

@@ -327,7 +327,7 @@ TEST(FoldedBoundaryConditions, ClampedEdgeKeepsSymmetryAndMakesKPositiveDefinite
   const std::vector<int> edge = vertices_at_x(mesh, -0.5);
   ASSERT_EQ(edge.size(), 5u);
   for (Quadrature rule : {Quadrature::one_point, Quadrature::three_point, Quadrature::six_point}) {
-    const ShellModel model(mesh, test_material(), {BoundaryCondition{edge, {true, true, true}, true}}, rule);
+    const ShellModel model(mesh, test_material(), {BoundaryCondition{edge, {true, true, true}, true, false, {}}}, rule);
     // Clamped border vertices with an interior neighbour are tied (dependent), not free.
     int dependent = 0;
     for (int v : edge)
@@ -347,7 +347,7 @@ TEST(FoldedBoundaryConditions, HingedEdgesKeepSymmetryAndMakeKPositiveDefinite) 
   for (int v : vertices_at_x(mesh, 0.5)) edges.push_back(v);
   ASSERT_EQ(edges.size(), 10u);
   for (Quadrature rule : {Quadrature::one_point, Quadrature::three_point, Quadrature::six_point}) {
-    const ShellModel model(mesh, test_material(), {BoundaryCondition{edges, {true, true, true}, false}}, rule);
+    const ShellModel model(mesh, test_material(), {BoundaryCondition{edges, {true, true, true}, false, false, {}}}, rule);
     for (int v : edges)
       for (int c = 0; c < 3; ++c) EXPECT_EQ(model.dofs().status(v, c), DofStatus::fixed);
     const Eigen::VectorXd ratios = check_folded(model, 30);
@@ -360,7 +360,7 @@ TEST(FoldedBoundaryConditions, HingedEdgesKeepSymmetryAndMakeKPositiveDefinite) 
 TEST(FoldedBoundaryConditions, SingleHingedEdgeLeavesOnlyTheRotationAboutIt) {
   const TriMesh mesh = flat_grid();
   const std::vector<int> edge = vertices_at_x(mesh, -0.5);
-  const ShellModel model(mesh, test_material(), {BoundaryCondition{edge, {true, true, true}, false}},
+  const ShellModel model(mesh, test_material(), {BoundaryCondition{edge, {true, true, true}, false, false, {}}},
                          Quadrature::three_point);
   const Eigen::VectorXd ratios = check_folded(model, 15);
   EXPECT_LT(std::abs(ratios(0)), 1e-12);
