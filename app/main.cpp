@@ -1,5 +1,5 @@
-// Command-line entry point: `clothsim SCENE.json [--out DIR]`. Argument parsing (CLI11) lives in
-// this file only; the work is done by run_scene_file (app/run.hpp).
+// Command-line entry point: `clothsim SCENE.json [--out DIR] [--end T]`. Argument parsing (CLI11)
+// lives in this file only; the work is done by run_scene_file (app/run.hpp).
 #include "app/run.hpp"
 
 #include <CLI/CLI.hpp>
@@ -11,14 +11,18 @@ int main(int argc, char** argv) {
   CLI::App app{
       "clothsim: Kirchhoff-Love thin-shell cloth simulator on Loop-subdivision surfaces.\n"
       "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes\n"
-      "result.json and limit.obj to DIR/<scene name>/.",
+      "its results to DIR/<scene name>/: result.json and limit.obj for a static scene;\n"
+      "probes.csv, stats.csv, summary.json and (with output.obj) frames/ for a dynamic one.",
       "clothsim"};
   std::string scene;
   std::string out = "out";
+  double end = 0.0;
   app.add_option("scene", scene, "Scene file (JSON)")->required()->type_name("SCENE.json");
   app.add_option("--out", out, "Output root; results go to DIR/<scene name>/")
       ->type_name("DIR")
       ->capture_default_str();
+  CLI::Option* end_option =
+      app.add_option("--end", end, "Dynamic scenes: simulate to time T [s] instead of time.end")->type_name("T");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -26,5 +30,7 @@ int main(int argc, char** argv) {
     std::cerr << "clothsim: error: " << e.what() << "\nRun with --help for usage.\n";
     return 1;
   }
-  return clothsim::run_scene_file(scene, out);
+  clothsim::RunOptions options;
+  if (end_option->count() > 0) options.end = end;
+  return clothsim::run_scene_file(scene, out, options);
 }

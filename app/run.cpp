@@ -1,7 +1,9 @@
 // The clothsim command's work: scene → static solve → result.json and limit.obj, written into a
-// temporary sibling folder that is renamed into place only once everything has succeeded.
+// temporary sibling folder that is renamed into place only once everything has succeeded; dynamic
+// scenes are handed to run_dynamic_scene (app/dynamic_run.hpp).
 #include "app/run.hpp"
 
+#include "app/dynamic_run.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/static/static_solve.hpp"
@@ -10,6 +12,8 @@
 
 #include <unistd.h>
 
+#include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <functional>
@@ -121,14 +125,42 @@ void check_result(const Scene& scene, const StaticResult& result) {
                              std::to_string(n) + " control vertices");
 }
 
+// Shortest decimal form that reads back to the identical double, as in scene error messages
+// ("0.0001", "2.0"); "nan", "inf" for those.
+std::string shortest(double v) {
+  if (std::isfinite(v)) return OrderedJson(v).dump();
+  char buffer[16];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), v);
+  return std::string(buffer, result.ptr);
+}
+
+// Applies --end to a dynamic scene; throws for a static scene or an invalid value.
+void apply_end_option(Scene& scene, const RunOptions& options) {
+  if (!options.end) return;
+  const double end = *options.end;
+  if (scene.analysis != "dynamic")
+    throw std::runtime_error("--end: only applies to dynamic scenes (" + scene.file.string() + " is " +
+                             scene.analysis + ")");
+  if (!(std::isfinite(end) && end > 0))
+    throw std::runtime_error("--end: must be a finite number > 0 [s] (got " + shortest(end) + ")");
+  if (end < scene.dynamic.time.dt)
+    throw std::runtime_error("--end: must be >= time.dt = " + shortest(scene.dynamic.time.dt) + " [s] (got " +
+                             shortest(end) + ")");
+  log_line("--end: simulating to t = " + shortest(end) + " s instead of time.end = " +
+           shortest(scene.dynamic.time.end) + " s");
+  scene.dynamic.time.end = end;
+}
+
 }  // namespace
 
-int run_scene_file(const fs::path& scene_file, const fs::path& out_root) {
+int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const RunOptions& options) {
   try {
     if (out_root.empty()) throw std::runtime_error("--out: the output folder must not be empty");
-    const Scene scene = load_scene(scene_file, log_line);
+    Scene scene = load_scene(scene_file, log_line);
     log_line("scene " + scene.name + ": " + std::to_string(scene.problem.mesh.num_vertices()) +
              " control vertices, " + std::to_string(scene.problem.mesh.num_triangles()) + " triangles");
+    apply_end_option(scene, options);
+    if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root);
 
     StaticResult result;
     try {

@@ -1,15 +1,24 @@
-// Running one scene from the command line: load and validate it, run the analysis, and publish
-// the output folder DIR/<name>/ atomically (nothing is left behind on failure).
+// Running one scene from the command line: load and validate it, run the analysis, and write
+// the output folder DIR/<name>/ (static: published atomically, nothing is left behind on failure;
+// dynamic: streamed, see app/dynamic_run.hpp).
 #pragma once
 
 #include <filesystem>
+#include <optional>
 
 namespace clothsim {
 
-// Loads `scene_file`, runs its analysis and writes `out_root`/<scene name>/ (result.json,
-// limit.obj), replacing an older folder of that name. Log lines and errors go to stderr
+struct RunOptions {
+  std::optional<double> end;  // --end T [s]: replaces time.end of a dynamic scene
+};
+
+// Loads `scene_file`, runs its analysis and writes `out_root`/<scene name>/, replacing an older
+// folder of that name: result.json and limit.obj for a static scene; probes.csv, stats.csv,
+// summary.json and optional OBJ frames for a dynamic one. Log lines and errors go to stderr
 // ("clothsim: ...", "clothsim: error: ..."), the summary to stdout. Returns the process exit code:
-// 0 on success, 1 on any error (in which case no output folder or file has been created).
-int run_scene_file(const std::filesystem::path& scene_file, const std::filesystem::path& out_root);
+// 0 on success, 1 on any error. Invalid input (scene, options) creates no output folder or file;
+// a dynamic run that fails part-way keeps what it has written (summary.json says "failed").
+int run_scene_file(const std::filesystem::path& scene_file, const std::filesystem::path& out_root,
+                   const RunOptions& options = {});
 
 }  // namespace clothsim

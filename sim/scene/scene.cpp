@@ -1,9 +1,11 @@
 // Scene loader: parses a scene file with nlohmann::json, checks every key, type and range (the
-// messages carry the file and the key path), builds the mesh and the StaticProblem.
+// messages carry the file and the key path), builds the mesh, the StaticProblem and, for dynamic
+// scenes, the DynamicProblem.
 #include "sim/scene/scene.hpp"
 
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/obj_io.hpp"
+#include "sim/shell/material_presets.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -22,6 +24,11 @@ namespace {
 using Json = nlohmann::json;
 
 const char* const kAxes[3] = {"x", "y", "z"};
+
+// Top-level keys that only a dynamic scene may have.
+const char* const kDynamicOnlyKeys[] = {"time", "damping", "solver", "corotational", "initial", "output"};
+
+const char* const kNeedsDynamic = "needs \"analysis\": \"dynamic\" (this scene is static)";
 
 std::string join_key(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
@@ -181,6 +188,11 @@ class Reader {
                              j.get<std::int64_t>() <= std::numeric_limits<int>::max());
     if (!fits) fail(path, "integer out of range (got " + j.dump() + ")");
     return static_cast<int>(j.get<std::int64_t>());
+  }
+
+  bool boolean(const Json& j, const std::string& path) const {
+    if (!j.is_boolean()) fail(path, "expected true or false (got " + describe(j) + ")");
+    return j.get<bool>();
   }
 
   std::string string(const Json& j, const std::string& path) const {
@@ -347,18 +359,34 @@ ShellMaterial read_material(const Reader& r, const Json* j) {
   if (j == nullptr) return ShellMaterial::from_solid(youngs, poisson, thickness, density);
   const std::string path = "material";
   r.check_object(*j, path,
-                 {"youngs_modulus", "poisson_ratio", "thickness", "density", "stretch_modulus",
+                 {"preset", "youngs_modulus", "poisson_ratio", "thickness", "density", "stretch_modulus",
                   "bending_rigidity", "areal_density"});
+  const Json* preset = r.find(*j, "preset");
+  std::string preset_name;
+  if (preset != nullptr) {
+    preset_name = r.choice(*preset, "material.preset", material_preset_names(), "preset");
+    // A preset is given by its stretch modulus, bending rigidity and areal density directly; it
+    // has no Young's modulus, thickness or density to combine with.
+    for (const char* solid : {"youngs_modulus", "thickness", "density"})
+      if (r.find(*j, solid) != nullptr)
+        r.fail(join_key(path, solid), "cannot be combined with \"preset\" (a preset sets stretch_modulus, "
+                                      "bending_rigidity, poisson_ratio and areal_density; override those instead)");
+  }
   if (const Json* v = r.find(*j, "youngs_modulus")) youngs = r.positive(*v, "material.youngs_modulus", "[Pa]");
-  if (const Json* v = r.find(*j, "poisson_ratio")) {
-    poisson = r.number(*v, "material.poisson_ratio");
+  const Json* poisson_json = r.find(*j, "poisson_ratio");
+  if (poisson_json != nullptr) {
+    poisson = r.number(*poisson_json, "material.poisson_ratio");
     if (!(poisson >= 0 && poisson < 0.5))
-      r.fail("material.poisson_ratio", "must be >= 0 and < 0.5 (got " + v->dump() + ")");
+      r.fail("material.poisson_ratio", "must be >= 0 and < 0.5 (got " + poisson_json->dump() + ")");
   }
   if (const Json* v = r.find(*j, "thickness")) thickness = r.positive(*v, "material.thickness", "[m]");
   if (const Json* v = r.find(*j, "density")) density = r.non_negative(*v, "material.density", "[kg/m³]");
 
   ShellMaterial m = ShellMaterial::from_solid(youngs, poisson, thickness, density);
+  if (preset != nullptr) {
+    m = *material_preset(preset_name);
+    if (poisson_json != nullptr) m.poisson_ratio = poisson;
+  }
   if (const Json* v = r.find(*j, "stretch_modulus"))
     m.stretch_modulus = r.positive(*v, "material.stretch_modulus", "[N/m]");
   if (const Json* v = r.find(*j, "bending_rigidity"))
@@ -388,7 +416,41 @@ std::string bounding_box(const Eigen::MatrixX3d& v) {
   return "[" + format_point(lo) + ", " + format_point(hi) + "]";
 }
 
-std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, const TriMesh& mesh,
+Motion read_motion(const Reader& r, const Json& item, const std::string& path) {
+  if (!item.is_object()) r.fail(path, "expected an object (got " + describe(item) + ")");
+  const std::string type = r.choice(r.require(item, path, "type"), join_key(path, "type"),
+                                    {"rotate", "translate", "hold"}, "motion type");
+  Motion m;
+  if (type == "rotate") {
+    r.check_object(item, path, {"type", "axis", "center", "angle_deg", "start", "end"});
+    m.type = Motion::Type::rotate;
+  } else if (type == "translate") {
+    r.check_object(item, path, {"type", "displacement", "start", "end"});
+    m.type = Motion::Type::translate;
+  } else {
+    r.check_object(item, path, {"type", "start", "end"});
+    m.type = Motion::Type::hold;
+  }
+  m.start = r.non_negative(r.require(item, path, "start"), join_key(path, "start"), "[s]");
+  const std::string end_path = join_key(path, "end");
+  m.end = r.number(r.require(item, path, "end"), end_path);
+  if (!(m.end >= m.start))
+    r.fail(end_path, "must be >= start = " + format_number(m.start) + " [s] (got " + format_number(m.end) + ")");
+  if (m.type == Motion::Type::rotate) {
+    const std::string axis_path = join_key(path, "axis");
+    m.axis = r.vec3(r.require(item, path, "axis"), axis_path);
+    if (!(m.axis.norm() > 0)) r.fail(axis_path, "must be a non-zero vector (got " + format_point(m.axis) + ")");
+    if (const Json* c = r.find(item, "center")) m.center = r.vec3(*c, join_key(path, "center"));
+    m.angle_deg = r.number(r.require(item, path, "angle_deg"), join_key(path, "angle_deg"));
+  } else if (m.type == Motion::Type::translate) {
+    m.displacement = r.vec3(r.require(item, path, "displacement"), join_key(path, "displacement"));
+  }
+  const std::string problem = validate(m);
+  if (!problem.empty()) r.fail(path, problem);
+  return m;
+}
+
+std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, const TriMesh& mesh, bool dynamic,
                                              const LogFn& log) {
   std::vector<BoundaryCondition> out;
   if (j == nullptr) return out;
@@ -396,7 +458,7 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
   for (std::size_t i = 0; i < j->size(); ++i) {
     const std::string path = join_index("boundary", i);
     const Json& item = (*j)[i];
-    r.check_object(item, path, {"select", "fix", "rotation"});
+    r.check_object(item, path, {"select", "fix", "rotation", "motion"});
     BoundaryCondition bc;
 
     const std::string select_path = join_key(path, "select");
@@ -429,6 +491,15 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
       const std::string kind = r.choice(*rotation, join_key(path, "rotation"), {"free", "clamped", "symmetry"});
       bc.clamped = kind == "clamped";
       bc.symmetric = kind == "symmetry";
+    }
+    if (const Json* motion = r.find(item, "motion")) {
+      const std::string motion_path = join_key(path, "motion");
+      if (!dynamic) r.fail(motion_path, kNeedsDynamic);
+      r.array(*motion, motion_path);
+      for (std::size_t m = 0; m < motion->size(); ++m)
+        bc.motion.push_back(read_motion(r, (*motion)[m], join_index(motion_path, m)));
+      if (!bc.motion.empty() && !bc.fix[0] && !bc.fix[1] && !bc.fix[2])
+        r.fail(motion_path, "has no effect: the motion drives the fixed components and \"fix\" is empty");
     }
 
     bc.vertices = select_box(mesh.vertices, lo, hi);
@@ -467,6 +538,63 @@ void read_loads(const Reader& r, const Json* j, StaticProblem& problem, const Lo
       problem.point_loads.push_back(load);
     }
   }
+}
+
+TimeSettings read_time(const Reader& r, const Json* j) {
+  TimeSettings t;
+  if (j == nullptr) return t;
+  r.check_object(*j, "time", {"dt", "end", "output_fps"});
+  if (const Json* v = r.find(*j, "dt")) t.dt = r.positive(*v, "time.dt", "[s]");
+  if (const Json* v = r.find(*j, "end")) t.end = r.positive(*v, "time.end", "[s]");
+  if (t.end < t.dt)
+    r.fail("time.end", "must be >= time.dt = " + format_number(t.dt) + " [s] (got " + format_number(t.end) + ")");
+  if (const Json* v = r.find(*j, "output_fps")) t.output_fps = r.positive(*v, "time.output_fps", "[1/s]");
+  return t;
+}
+
+DampingSettings read_damping(const Reader& r, const Json* j) {
+  DampingSettings d;
+  if (j == nullptr) return d;
+  r.check_object(*j, "damping", {"stiffness", "mass"});
+  if (const Json* v = r.find(*j, "stiffness")) d.stiffness = r.non_negative(*v, "damping.stiffness", "[s]");
+  if (const Json* v = r.find(*j, "mass")) d.mass = r.non_negative(*v, "damping.mass", "[1/s]");
+  return d;
+}
+
+SolverSettings read_solver(const Reader& r, const Json* j) {
+  SolverSettings s;
+  if (j == nullptr) return s;
+  r.check_object(*j, "solver", {"type", "tolerance", "max_iterations", "newton_iterations"});
+  if (const Json* v = r.find(*j, "type"))
+    s.type = r.choice(*v, "solver.type", {"pcg", "cholmod"}, "solver type") == "cholmod" ? LinearSolverType::cholmod
+                                                                                      : LinearSolverType::pcg;
+  if (const Json* v = r.find(*j, "tolerance")) {
+    s.tolerance = r.number(*v, "solver.tolerance");
+    if (!(s.tolerance > 0 && s.tolerance < 1))
+      r.fail("solver.tolerance", "must be > 0 and < 1 (got " + v->dump() + ")");
+  }
+  if (const Json* v = r.find(*j, "max_iterations")) s.max_iterations = r.integer_at_least(*v, "solver.max_iterations", 1);
+  if (const Json* v = r.find(*j, "newton_iterations"))
+    s.newton_iterations = r.integer_at_least(*v, "solver.newton_iterations", 1);
+  return s;
+}
+
+InitialState read_initial(const Reader& r, const Json* j) {
+  InitialState s;
+  if (j == nullptr) return s;
+  r.check_object(*j, "initial", {"velocity", "angular_velocity", "center"});
+  if (const Json* v = r.find(*j, "velocity")) s.velocity = r.vec3(*v, "initial.velocity");
+  if (const Json* v = r.find(*j, "angular_velocity")) s.angular_velocity = r.vec3(*v, "initial.angular_velocity");
+  if (const Json* v = r.find(*j, "center")) s.center = r.vec3(*v, "initial.center");
+  return s;
+}
+
+// "output": {"obj": bool}; returns whether OBJ frames are wanted.
+bool read_output(const Reader& r, const Json* j) {
+  if (j == nullptr) return false;
+  r.check_object(*j, "output", {"obj"});
+  const Json* obj = r.find(*j, "obj");
+  return obj != nullptr && r.boolean(*obj, "output.obj");
 }
 
 std::vector<Probe> read_probes(const Reader& r, const Json* j, const TriMesh& mesh, const LogFn& log) {
@@ -523,7 +651,7 @@ Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
   const Json root = parse_file(r, file);
   r.check_object(root, "",
                  {"name", "description", "analysis", "mesh", "material", "boundary", "loads", "probes",
-                  "numerics"});
+                  "numerics", "time", "damping", "solver", "corotational", "initial", "output"});
 
   Scene scene;
   scene.file = file;
@@ -541,15 +669,27 @@ Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
   }
   if (const Json* d = r.find(root, "description")) scene.description = r.string(*d, "description");
   scene.analysis = "static";
-  if (const Json* a = r.find(root, "analysis")) {
-    if (a->is_string() && a->get<std::string>() == "dynamic")
-      r.fail("analysis", "dynamic analysis is not available yet (allowed: \"static\")");
-    scene.analysis = r.choice(*a, "analysis", {"static"});
-  }
+  if (const Json* a = r.find(root, "analysis")) scene.analysis = r.choice(*a, "analysis", {"static", "dynamic"});
+  const bool dynamic = scene.analysis == "dynamic";
+  if (!dynamic)
+    for (const char* key : kDynamicOnlyKeys)
+      if (r.find(root, key) != nullptr) r.fail(key, kNeedsDynamic);
 
   // Cheap checks first, the mesh (possibly large) after.
   scene.problem.material = read_material(r, r.find(root, "material"));
   scene.problem.quadrature = read_numerics(r, r.find(root, "numerics"));
+  DynamicProblem& dyn = scene.dynamic;
+  if (dynamic) {
+    if (!(scene.problem.material.areal_density > 0))
+      r.fail("material", "a dynamic analysis needs a positive areal density (mass) [kg/m²] (got " +
+                             format_number(scene.problem.material.areal_density) + ")");
+    dyn.time = read_time(r, r.find(root, "time"));
+    dyn.damping = read_damping(r, r.find(root, "damping"));
+    dyn.solver = read_solver(r, r.find(root, "solver"));
+    if (const Json* c = r.find(root, "corotational")) dyn.corotational = r.boolean(*c, "corotational");
+    dyn.initial = read_initial(r, r.find(root, "initial"));
+    scene.write_obj_frames = read_output(r, r.find(root, "output"));
+  }
 
   TriMesh mesh = build_mesh(r, r.require(root, "", "mesh"), file.parent_path(), say);
   try {
@@ -558,9 +698,21 @@ Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
     r.fail("mesh", e.what());
   }
 
-  scene.problem.boundary = read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, say);
+  scene.problem.boundary = read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, dynamic, say);
   read_loads(r, r.find(root, "loads"), scene.problem, say);
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
+
+  if (dynamic) {
+    const StaticProblem& p = scene.problem;
+    dyn.mesh = p.mesh;
+    dyn.material = p.material;
+    dyn.boundary = p.boundary;
+    dyn.gravity = p.gravity;
+    dyn.surface_load = p.surface_load;
+    dyn.pressure = p.pressure;
+    dyn.point_loads = p.point_loads;
+    dyn.quadrature = p.quadrature;
+  }
   return scene;
 }
 

@@ -51,6 +51,7 @@ ShellElement make_element(const ExtendedMesh& ext, const DofMap& dofs, const Tri
   for (Eigen::Index p = 0; p < np; ++p)
     for (int c = 0; c < 3; ++c)
       for (const auto& [dof, w] : dofs.combination(el.patch[p], c)) el.fold(3 * p + c, 3 * col.at(dof / 3) + dof % 3) += w;
+  el.sparse_fold = el.fold.sparseView();
   return el;
 }
 
@@ -176,6 +177,34 @@ Eigen::SparseMatrix<double> ShellModel::stiffness() const {
       }
     });
   return k;
+}
+
+Eigen::MatrixXd ShellModel::patch_stiffness(int e) const {
+  const ShellElement& el = elements_[e];
+  return element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_);
+}
+
+Eigen::VectorXd ShellModel::patch_vector(int e, const Eigen::VectorXd& real) const {
+  const ShellElement& el = elements_[e];
+  const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size());
+  Eigen::VectorXd out(3 * np);
+  if (el.identity) {
+    for (Eigen::Index p = 0; p < np; ++p) out.segment<3>(3 * p) = real.segment<3>(3 * el.patch[p]);
+    return out;
+  }
+  Eigen::VectorXd local(3 * static_cast<Eigen::Index>(el.real.size()));
+  for (size_t r = 0; r < el.real.size(); ++r) local.segment<3>(3 * static_cast<Eigen::Index>(r)) = real.segment<3>(3 * el.real[r]);
+  return el.fold * local;
+}
+
+void ShellModel::add_patch_matrix(int e, const Eigen::MatrixXd& k_patch, Eigen::SparseMatrix<double>& global) const {
+  const ShellElement& el = elements_[e];
+  if (el.identity) {
+    scatter_matrix(e, k_patch, global.valuePtr());
+    return;
+  }
+  const Eigen::MatrixXd kt = k_patch * el.sparse_fold;
+  scatter_matrix(e, Eigen::MatrixXd(el.sparse_fold.transpose() * kt), global.valuePtr());
 }
 
 void ShellModel::restrict_to_free(Eigen::SparseMatrix<double>& k) const {

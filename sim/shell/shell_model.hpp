@@ -34,6 +34,7 @@ struct ShellElement {
   std::vector<int> real;            // real vertices the patch's displacements depend on
   bool identity = false;            // patch == real and every component free and itself
   Eigen::MatrixXd fold;             // 3·#patch × 3·#real weights (when !identity)
+  Eigen::SparseMatrix<double> sparse_fold;  // the same, sparse (most rows are unit rows)
 };
 
 class ShellModel {
@@ -62,6 +63,22 @@ class ShellModel {
   std::vector<std::string> unrestrained_rigid_motions() const;
   // Number of colour groups used for parallel assembly (elements of one group share no vertex).
   int num_colors() const { return static_cast<int>(colors_.size()); }
+  const std::vector<std::vector<int>>& color_groups() const { return colors_; }
+
+  // Building blocks for other assemblies (the corotational dynamics):
+  // the zero-valued matrix with the stiffness pattern (3·#V square);
+  Eigen::SparseMatrix<double> zero_matrix() const { return pattern_; }
+  // the rest stiffness of element e in patch coordinates (3·#patch square, not folded);
+  Eigen::MatrixXd patch_stiffness(int e) const;
+  // the element's patch displacements (3·#patch) from real displacements (3·#V);
+  Eigen::VectorXd patch_vector(int e, const Eigen::VectorXd& real) const;
+  // folds a patch-coordinate matrix into the values of a matrix with the stiffness pattern
+  // (elements of one colour group may do this concurrently);
+  void add_patch_matrix(int e, const Eigen::MatrixXd& k_patch, Eigen::SparseMatrix<double>& global) const;
+  // folds a patch-coordinate vector into a global vector.
+  void add_patch_vector(int e, const Eigen::VectorXd& f_patch, Eigen::VectorXd& global) const {
+    scatter_vector(elements_[e], f_patch, global);
+  }
 
   // Consistent load of a force per unit reference area q [N/m²]: f_I = ∫ N_I q dA.
   Eigen::VectorXd area_load(const Eigen::Vector3d& q) const;

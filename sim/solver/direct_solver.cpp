@@ -5,12 +5,14 @@
 namespace clothsim {
 
 struct DirectSolver::Impl {
-  // Supernodal LLᵀ (a matrix that is not positive definite fails the factorisation), AMD
-  // ordering: measured fastest on shell stiffness matrices with OpenBLAS (docs/performance.md).
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  // LLᵀ (a matrix that is not positive definite fails the factorisation), AMD ordering:
+  // measured fastest on shell stiffness matrices with OpenBLAS (docs/performance.md).
+  Eigen::CholmodDecomposition<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  bool analysed = false;
 };
 
-DirectSolver::DirectSolver() : impl_(std::make_unique<Impl>()) {
+DirectSolver::DirectSolver(bool supernodal) : impl_(std::make_unique<Impl>()) {
+  impl_->llt.setMode(supernodal ? Eigen::CholmodSupernodalLLt : Eigen::CholmodSimplicialLLt);
   impl_->llt.cholmod().nmethods = 1;
   impl_->llt.cholmod().method[0].ordering = CHOLMOD_AMD;
   impl_->llt.cholmod().postorder = 1;
@@ -20,6 +22,15 @@ DirectSolver::~DirectSolver() = default;
 
 bool DirectSolver::factorize(const Eigen::SparseMatrix<double>& a) {
   impl_->llt.compute(a);
+  return impl_->llt.info() == Eigen::Success;
+}
+
+bool DirectSolver::refactorize(const Eigen::SparseMatrix<double>& a) {
+  if (!impl_->analysed) {
+    impl_->llt.analyzePattern(a);
+    impl_->analysed = true;
+  }
+  impl_->llt.factorize(a);
   return impl_->llt.info() == Eigen::Success;
 }
 

@@ -11,7 +11,9 @@ namespace clothsim {
 
 class DirectSolver {
  public:
-  DirectSolver();
+  // `supernodal`: CHOLMOD's supernodal Cholesky (BLAS-3, best for large matrices); otherwise
+  // its simplicial one (less overhead for the small systems of a dynamic run).
+  explicit DirectSolver(bool supernodal = true);
   ~DirectSolver();
   DirectSolver(const DirectSolver&) = delete;
   DirectSolver& operator=(const DirectSolver&) = delete;
@@ -19,6 +21,9 @@ class DirectSolver {
   // Analyses and factorises A (symmetric; the lower triangle is read). Returns false when A
   // is not positive definite (e.g. a structure with an unrestrained rigid motion).
   bool factorize(const Eigen::SparseMatrix<double>& a);
+  // Numeric factorisation of a matrix with the same pattern as the last one analysed (the
+  // symbolic analysis is done on the first call only). Returns false when not positive definite.
+  bool refactorize(const Eigen::SparseMatrix<double>& a);
   // Solves A x = b with the last factorisation.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
 

@@ -1,5 +1,6 @@
 // The clothsim command: runs the built binary on scenes written to a fresh temporary folder and
-// checks exit codes, error messages, and that failed runs leave no output behind.
+// checks exit codes, error messages, that invalid input leaves no output behind, and the streamed
+// outputs of dynamic runs (also when they fail part-way).
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -50,6 +51,50 @@ const char* const kGridPlate = R"({
   "loads": {"surface_load": [0, 0, -1]},
   "probes": [{"name": "center", "at": [0, 0, 0]}, {"name": "edge", "at": [0.5, 0, 0]}]
 })";
+
+// A 0.2 m × 0.2 m cloth (4 × 4 cells, 25 vertices) pinned along its edge y = +0.1 m, falling
+// under gravity for 10 steps of 1 ms; frames at 500 fps (t = 0, 2, 4, 6, 8, 10 ms).
+const char* const kFallingCloth = R"({
+  "name": "cloth",
+  "analysis": "dynamic",
+  "mesh": {"primitive": "grid", "size": [0.2, 0.2], "divisions": [4, 4]},
+  "material": {"preset": "cotton"},
+  "boundary": [{"select": {"box": [[-0.11, 0.09, -1], [0.11, 0.11, 1]]}, "fix": ["x", "y", "z"]}],
+  "loads": {"gravity": [0, 0, -9.81]},
+  "time": {"dt": 0.001, "end": 0.01, "output_fps": 500},
+  "damping": {"stiffness": 0.001},
+  "probes": [{"name": "free_edge", "at": [0, -0.1, 0]}, {"name": "corner", "at": [0.1, -0.1, 0]}],
+  "output": {"obj": true}
+})";
+
+// A stiff sheet with a huge step and a conjugate gradient solver allowed one iteration: the
+// first step cannot converge.
+const char* const kFailingCloth = R"({
+  "name": "stiff",
+  "analysis": "dynamic",
+  "mesh": {"primitive": "grid", "size": [0.2, 0.2], "divisions": [4, 4]},
+  "material": {"preset": "metal"},
+  "boundary": [{"select": {"box": [[-0.11, 0.09, -1], [0.11, 0.11, 1]]}}],
+  "loads": {"gravity": [0, 0, -9.81]},
+  "time": {"dt": 0.1, "end": 1.0},
+  "solver": {"type": "pcg", "max_iterations": 1, "tolerance": 1e-14},
+  "probes": [{"name": "free_edge", "at": [0, -0.1, 0]}],
+  "output": {"obj": true}
+})";
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::istringstream in(line);
+  for (std::string field; std::getline(in, field, ',');) fields.push_back(field);
+  return fields;
+}
 
 class CliTest : public ::testing::Test {
  protected:
@@ -205,6 +250,144 @@ TEST_F(CliTest, StaticRunWritesOutputs) {
   int vertex_lines = 0;
   for (std::string line; std::getline(obj, line);) vertex_lines += line.rfind("v ", 0) == 0 ? 1 : 0;
   EXPECT_EQ(vertex_lines, j["vertices"].get<int>());
+}
+
+TEST_F(CliTest, DynamicRunWritesOutputs) {
+  const fs::path scene = write("cloth.json", kFallingCloth);
+  fs::create_directories(out_ / "cloth");
+  std::ofstream(out_ / "cloth" / "stale.txt") << "old";
+
+  const RunResult r = run_scene(scene);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "free_edge")) << r.out;
+  EXPECT_TRUE(contains(r.err, "step 10/10")) << r.err;  // progress lines
+  const fs::path dir = out_ / "cloth";
+  EXPECT_FALSE(fs::exists(dir / "stale.txt"));
+  for (const auto& e : fs::directory_iterator(out_))
+    EXPECT_NE(e.path().filename().string().front(), '.') << "left behind: " << e.path();
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_NE(e.path().filename().string().front(), '.') << "left behind: " << e.path();
+
+  // probes.csv: 11 states (steps 0..10) × 2 probes.
+  const std::vector<std::string> probes = lines_of(read_text(dir / "probes.csv"));
+  ASSERT_EQ(probes.size(), 1u + 11u * 2u);
+  EXPECT_EQ(probes[0], "step,t,name,ux,uy,uz");
+  EXPECT_EQ(probes[1], "0,0,free_edge,0,0,0");
+  EXPECT_EQ(probes[2], "0,0,corner,0,0,0");
+  for (std::size_t i = 1; i < probes.size(); ++i) {
+    const std::vector<std::string> f = split_csv(probes[i]);
+    ASSERT_EQ(f.size(), 6u) << probes[i];
+    EXPECT_EQ(std::stoi(f[0]), static_cast<int>((i - 1) / 2));
+    EXPECT_NEAR(std::stod(f[1]), 0.001 * std::stoi(f[0]), 1e-12);
+    EXPECT_EQ(f[2], i % 2 == 1 ? "free_edge" : "corner");
+  }
+  const std::vector<std::string> last = split_csv(probes[probes.size() - 2]);
+  EXPECT_EQ(last[0], "10");
+  EXPECT_LT(std::stod(last[5]), -1e-5);  // the free edge falls (½ g t² ≈ 4.9e-4 m without stiffness)
+
+  // stats.csv: one row per step.
+  const std::vector<std::string> stats = lines_of(read_text(dir / "stats.csv"));
+  ASSERT_EQ(stats.size(), 11u);
+  EXPECT_EQ(stats[0], "step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy");
+  for (std::size_t i = 1; i < stats.size(); ++i) {
+    const std::vector<std::string> f = split_csv(stats[i]);
+    ASSERT_EQ(f.size(), 9u) << stats[i];
+    EXPECT_EQ(std::stoi(f[0]), static_cast<int>(i));
+    EXPECT_GE(std::stoi(f[2]), 1);
+    EXPECT_GT(std::stod(f[7]), 0.0);  // kinetic energy of the falling cloth
+  }
+
+  // Frames at t = 0, 2, ..., 10 ms, each with one vertex per control vertex.
+  for (int k = 0; k <= 5; ++k) {
+    const fs::path frame = dir / "frames" / ("mesh_000" + std::to_string(k) + ".obj");
+    ASSERT_TRUE(fs::exists(frame)) << frame;
+    int vertex_lines = 0, face_lines = 0;
+    for (const std::string& line : lines_of(read_text(frame))) {
+      vertex_lines += line.rfind("v ", 0) == 0 ? 1 : 0;
+      face_lines += line.rfind("f ", 0) == 0 ? 1 : 0;
+    }
+    EXPECT_EQ(vertex_lines, 25);
+    EXPECT_EQ(face_lines, 32);
+  }
+  EXPECT_FALSE(fs::exists(dir / "frames" / "mesh_0006.obj"));
+
+  const nlohmann::json j = nlohmann::json::parse(read_text(dir / "summary.json"));
+  EXPECT_EQ(j["scene"], "cloth");
+  EXPECT_EQ(j["analysis"], "dynamic");
+  EXPECT_EQ(j["status"], "completed");
+  EXPECT_FALSE(j.contains("error"));
+  EXPECT_EQ(j["steps"], 10);
+  EXPECT_NEAR(j["simulated_time"].get<double>(), 0.01, 1e-12);
+  EXPECT_EQ(j["frames"], 6);
+  EXPECT_GE(j["max_solver_iterations"].get<int>(), 1);
+  EXPECT_TRUE(j["wall_seconds"].is_number());
+  for (const std::string part : {"rotate", "assemble", "solve"}) EXPECT_TRUE(j["seconds"][part].is_number()) << part;
+  EXPECT_TRUE(j["warnings"].is_array());
+
+  // Deterministic: a second run writes the same probes.csv and frames.
+  const RunResult again = run(shell_quote(scene.string()) + " --out " + shell_quote((dir_ / "again").string()));
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_EQ(read_text(dir_ / "again" / "cloth" / "probes.csv"), read_text(dir / "probes.csv"));
+  EXPECT_EQ(read_text(dir_ / "again" / "cloth" / "frames" / "mesh_0005.obj"), read_text(dir / "frames" / "mesh_0005.obj"));
+}
+
+TEST_F(CliTest, DynamicEndOptionShortensRun) {
+  const fs::path scene = write("cloth.json", kFallingCloth);
+  const RunResult r = run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --end 0.004");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(lines_of(read_text(out_ / "cloth" / "stats.csv")).size(), 5u);
+  EXPECT_EQ(lines_of(read_text(out_ / "cloth" / "probes.csv")).size(), 1u + 5u * 2u);
+  const nlohmann::json j = nlohmann::json::parse(read_text(out_ / "cloth" / "summary.json"));
+  EXPECT_EQ(j["steps"], 4);
+  EXPECT_EQ(j["frames"], 3);
+}
+
+TEST_F(CliTest, DynamicInvalidInputWritesNothing) {
+  const fs::path scene = write("cloth.json", kFallingCloth);
+  expect_failure(run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --end 0"),
+                 {"--end: must be a finite number > 0 [s] (got 0.0)"});
+  expect_failure(run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --end 0.0001"),
+                 {"--end: must be >= time.dt = 0.001 [s] (got 0.0001)"});
+  const fs::path plate = write("plate.json", kGridPlate);
+  expect_failure(run(shell_quote(plate.string()) + " --out " + shell_quote(out_.string()) + " --end 1"),
+                 {"--end: only applies to dynamic scenes"});
+  const fs::path bad = write("bad_dt.json", R"({"analysis": "dynamic",
+      "mesh": {"primitive": "grid", "size": [1, 1], "divisions": [4, 4]}, "time": {"dt": -0.01}})");
+  expect_failure(run_scene(bad), {bad.string() + ": time.dt: must be > 0 [s] (got -0.01)"});
+  const fs::path motion = write("bad_motion.json", R"({"analysis": "dynamic",
+      "mesh": {"primitive": "grid", "size": [1, 1], "divisions": [4, 4]},
+      "boundary": [{"select": {"box": [[-1, -1, -1], [1, 1, 1]]}, "motion": [{"type": "rotate", "start": 0, "end": 1}]}]})");
+  expect_failure(run_scene(motion), {motion.string() + ": boundary[0].motion[0].axis: required key is missing"});
+}
+
+TEST_F(CliTest, DynamicRunFailureKeepsOutputs) {
+  const fs::path scene = write("stiff.json", kFailingCloth);
+  const RunResult r = run_scene(scene);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_TRUE(contains(r.err, "clothsim: error: " + scene.string() + ": step ")) << r.err;
+  EXPECT_TRUE(contains(r.err, " s): ")) << r.err;
+  const fs::path dir = out_ / "stiff";
+  ASSERT_TRUE(fs::exists(dir / "summary.json"));
+  ASSERT_TRUE(fs::exists(dir / "probes.csv"));
+  ASSERT_TRUE(fs::exists(dir / "stats.csv"));
+  ASSERT_TRUE(fs::exists(dir / "frames" / "mesh_0000.obj"));  // the initial state
+
+  const nlohmann::json j = nlohmann::json::parse(read_text(dir / "summary.json"));
+  EXPECT_EQ(j["status"], "failed");
+  ASSERT_TRUE(j["error"].is_string());
+  EXPECT_TRUE(contains(j["error"].get<std::string>(), "step ")) << j["error"];
+  const int steps = j["steps"].get<int>();
+  EXPECT_LT(steps, 10);
+  EXPECT_EQ(j["frames"].get<int>(), 1 + 3 * steps);  // 30 fps with 0.1 s steps: three frames per step
+
+  // Everything up to the failed step is kept: step 0 and every completed step.
+  const std::vector<std::string> probes = lines_of(read_text(dir / "probes.csv"));
+  ASSERT_EQ(probes.size(), 1u + static_cast<std::size_t>(steps) + 1u);
+  EXPECT_EQ(probes[0], "step,t,name,ux,uy,uz");
+  EXPECT_EQ(probes[1], "0,0,free_edge,0,0,0");
+  const std::vector<std::string> stats = lines_of(read_text(dir / "stats.csv"));
+  ASSERT_EQ(stats.size(), 1u + static_cast<std::size_t>(steps));
+  EXPECT_EQ(stats[0], "step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy");
 }
 
 }  // namespace

@@ -1,16 +1,20 @@
-// Scene loader: defaults, material overrides, vertex selection, nearest-vertex lookup, and error
-// messages that name the file and the key path.
+// Scene loader: defaults, material overrides and presets, vertex selection, nearest-vertex
+// lookup, dynamic settings and scripted motions, error messages that name the file and the key
+// path, and every shipped scene.
 #include "sim/scene/scene.hpp"
 
 #include "sim/mesh/generators.hpp"
+#include "sim/shell/material_presets.hpp"
 
 #include <gtest/gtest.h>
 
 #include <stdlib.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -248,11 +252,12 @@ TEST_F(SceneLoader, BoundaryErrors) {
                        expected("boundary[0].select.box[1]: expected an array of 3 numbers")));
 }
 
-TEST_F(SceneLoader, AnalysisDynamicRejected) {
-  EXPECT_EQ(error(std::string(R"({"analysis": "dynamic", )") + kGrid4 + "}"),
-            expected("analysis: dynamic analysis is not available yet (allowed: \"static\")"));
-  EXPECT_TRUE(contains(error(std::string(R"({"analysis": "modal", )") + kGrid4 + "}"),
-                       expected("analysis: unknown value \"modal\" (allowed: \"static\")")));
+TEST_F(SceneLoader, AnalysisValues) {
+  EXPECT_EQ(error(std::string(R"({"analysis": "modal", )") + kGrid4 + "}"),
+            expected("analysis: unknown value \"modal\" (allowed: \"static\", \"dynamic\")"));
+  EXPECT_TRUE(contains(error(std::string(R"({"analysis": 1, )") + kGrid4 + "}"), expected("analysis: expected a string")));
+  EXPECT_EQ(load(std::string(R"({"analysis": "dynamic", )") + kGrid4 + "}").analysis, "dynamic");
+  EXPECT_EQ(load(std::string(R"({"analysis": "static", )") + kGrid4 + "}").analysis, "static");
 }
 
 TEST_F(SceneLoader, NamesMustBeSafeFolderNames) {
@@ -338,6 +343,403 @@ TEST_F(SceneLoader, ShippedScenesLoad) {
   EXPECT_NEAR(total.z(), -0.001, 1e-15);
   ASSERT_EQ(c.probes.size(), 1u);
   EXPECT_LT((c.problem.mesh.vertices.row(c.probes[0].vertex).transpose() - Eigen::Vector3d(0.5, 0, 0)).norm(), 1e-12);
+}
+
+// ---- Material presets -----------------------------------------------------------------------
+
+TEST_F(SceneLoader, MaterialPresetTable) {
+  const std::vector<std::string> names = material_preset_names();
+  for (const std::string name :
+       {"cotton", "metal", "cotton_broadcloth", "wool_tropical", "polyester_tropical", "polyester_faille",
+        "gray_interlock", "black_denim", "royal_target", "ivory_rib_knit", "camel_ponte_roma", "navy_sparkle_sweat",
+        "pink_ribbon_brown", "tango_red_jet_set", "white_dots_on_black", "white_swim_solid"})
+    EXPECT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+  for (const std::string& name : names) {
+    const std::optional<ShellMaterial> m = material_preset(name);
+    ASSERT_TRUE(m.has_value()) << name;
+    EXPECT_EQ(validate(*m), "") << name;
+    EXPECT_GT(m->areal_density, 0.0) << name;
+  }
+  EXPECT_FALSE(material_preset("silk").has_value());
+  EXPECT_FALSE(material_preset("Cotton").has_value());
+
+  const ShellMaterial cotton = *material_preset("cotton");
+  EXPECT_DOUBLE_EQ(cotton.stretch_modulus, 5000.0);
+  EXPECT_DOUBLE_EQ(cotton.poisson_ratio, 0.25);
+  EXPECT_DOUBLE_EQ(cotton.bending_rigidity, 1.157e-5);
+  EXPECT_DOUBLE_EQ(cotton.areal_density, 0.1238);
+  const ShellMaterial metal = *material_preset("metal");
+  EXPECT_DOUBLE_EQ(metal.stretch_modulus, 1e5);
+  EXPECT_DOUBLE_EQ(metal.poisson_ratio, 0.05);
+  EXPECT_NEAR(metal.bending_rigidity, 8.333e-3, 1e-6);
+  EXPECT_DOUBLE_EQ(metal.areal_density, 0.5);
+  const ShellMaterial wool = *material_preset("wool_tropical");
+  EXPECT_DOUBLE_EQ(wool.stretch_modulus, 5000.0);
+  EXPECT_DOUBLE_EQ(wool.bending_rigidity, 6.57e-6);
+  EXPECT_DOUBLE_EQ(wool.areal_density, 0.1629);
+  const ShellMaterial denim = *material_preset("black_denim");
+  EXPECT_DOUBLE_EQ(denim.stretch_modulus, std::sqrt(205.4 * 1013.9));
+  EXPECT_DOUBLE_EQ(denim.poisson_ratio, 0.25);
+  EXPECT_DOUBLE_EQ(denim.bending_rigidity, 6.42e-5);
+  EXPECT_DOUBLE_EQ(denim.areal_density, 0.324);
+}
+
+TEST_F(SceneLoader, MaterialPresetWithOverrides) {
+  const Scene s = load(std::string("{") + kGrid4 + R"(, "material": {"preset": "cotton"}})");
+  EXPECT_DOUBLE_EQ(s.problem.material.stretch_modulus, 5000.0);
+  EXPECT_DOUBLE_EQ(s.problem.material.bending_rigidity, 1.157e-5);
+  EXPECT_DOUBLE_EQ(s.problem.material.poisson_ratio, 0.25);
+  EXPECT_DOUBLE_EQ(s.problem.material.areal_density, 0.1238);
+
+  const Scene t = load(std::string("{") + kGrid4 + R"(, "material": {"preset": "cotton", "bending_rigidity": 1e-3,
+      "stretch_modulus": 50000, "poisson_ratio": 0.1, "areal_density": 0.2}})");
+  EXPECT_DOUBLE_EQ(t.problem.material.stretch_modulus, 50000.0);
+  EXPECT_DOUBLE_EQ(t.problem.material.bending_rigidity, 1e-3);
+  EXPECT_DOUBLE_EQ(t.problem.material.poisson_ratio, 0.1);
+  EXPECT_DOUBLE_EQ(t.problem.material.areal_density, 0.2);
+
+  // Key order does not matter: an override written before the preset still wins.
+  const Scene u = load(std::string("{") + kGrid4 + R"(, "material": {"bending_rigidity": 2e-3, "preset": "metal"}})");
+  EXPECT_DOUBLE_EQ(u.problem.material.bending_rigidity, 2e-3);
+  EXPECT_DOUBLE_EQ(u.problem.material.stretch_modulus, 1e5);
+}
+
+TEST_F(SceneLoader, MaterialPresetErrors) {
+  auto material = [&](const std::string& m) { return error(std::string("{") + kGrid4 + R"(, "material": )" + m + "}"); };
+  const std::string unknown = material(R"({"preset": "silk"})");
+  EXPECT_TRUE(contains(unknown, expected("material.preset: unknown preset \"silk\" (allowed: \"cotton\", \"metal\", ")))
+      << unknown;
+  for (const std::string& name : material_preset_names()) EXPECT_TRUE(contains(unknown, "\"" + name + "\"")) << name;
+  EXPECT_TRUE(contains(material(R"({"preset": 3})"), expected("material.preset: expected a string")));
+  EXPECT_TRUE(contains(material(R"({"preset": "cotton", "thickness": 0.001})"),
+                       expected("material.thickness: cannot be combined with \"preset\"")));
+  EXPECT_TRUE(contains(material(R"({"preset": "cotton", "youngs_modulus": 1e6})"),
+                       expected("material.youngs_modulus: cannot be combined with \"preset\"")));
+  EXPECT_TRUE(contains(material(R"({"preset": "cotton", "density": 100})"),
+                       expected("material.density: cannot be combined with \"preset\"")));
+  EXPECT_TRUE(contains(material(R"({"preset": "cotton", "bending_rigidity": -1})"),
+                       expected("material.bending_rigidity: must be > 0 [N·m]")));
+  EXPECT_TRUE(contains(material(R"({"preset": "cotton", "poisson_ratio": 0.7})"),
+                       expected("material.poisson_ratio: must be >= 0 and < 0.5")));
+  EXPECT_TRUE(contains(material(R"({"preset": "cotton", "colour": "red"})"),
+                       expected("material.colour: unknown key (allowed: preset, youngs_modulus")));
+}
+
+// ---- Dynamic scenes -------------------------------------------------------------------------
+
+const char* const kDynamicFull = R"({
+  "analysis": "dynamic",
+  "mesh": {"primitive": "grid", "size": [1.0, 1.0], "divisions": [4, 4]},
+  "material": {"preset": "cotton"},
+  "time": {"dt": 0.002, "end": 2.0, "output_fps": 25},
+  "damping": {"stiffness": 0.001, "mass": 0.5},
+  "solver": {"type": "cholmod", "tolerance": 1e-6, "max_iterations": 50, "newton_iterations": 3},
+  "corotational": false,
+  "initial": {"velocity": [1, 2, 3], "angular_velocity": [0, 0, 4], "center": [0.1, 0.2, 0.3]},
+  "boundary": [{"select": {"box": [[-1, -0.001, -1], [1, 0.001, 1]]}, "fix": ["x", "y", "z"],
+                "motion": [{"type": "rotate", "axis": [0, 1, 0], "center": [0, 0, 0], "angle_deg": 180, "start": 0.0, "end": 1.0},
+                           {"type": "translate", "displacement": [0, 0.05, 0], "start": 1.0, "end": 2.0},
+                           {"type": "hold", "start": 2.0, "end": 3.0}]},
+               {"select": {"box": [[-1, 0.49, -1], [1, 0.51, 1]]}, "fix": ["z"]}],
+  "loads": {"gravity": [0, 0, -9.81], "pressure": 2, "point_loads": [{"at": [0.5, 0.5, 0], "force": [0, 0, -1]}]},
+  "probes": [{"name": "p", "at": [0, 0, 0]}],
+  "numerics": {"quadrature": "three_point"},
+  "output": {"obj": true}
+})";
+
+TEST_F(SceneLoader, DynamicKeysParsed) {
+  const Scene s = load(kDynamicFull);
+  EXPECT_EQ(s.analysis, "dynamic");
+  const DynamicProblem& d = s.dynamic;
+  EXPECT_DOUBLE_EQ(d.time.dt, 0.002);
+  EXPECT_DOUBLE_EQ(d.time.end, 2.0);
+  EXPECT_DOUBLE_EQ(d.time.output_fps, 25.0);
+  EXPECT_DOUBLE_EQ(d.damping.stiffness, 0.001);
+  EXPECT_DOUBLE_EQ(d.damping.mass, 0.5);
+  EXPECT_EQ(d.solver.type, LinearSolverType::cholmod);
+  EXPECT_DOUBLE_EQ(d.solver.tolerance, 1e-6);
+  EXPECT_EQ(d.solver.max_iterations, 50);
+  EXPECT_EQ(d.solver.newton_iterations, 3);
+  EXPECT_FALSE(d.corotational);
+  EXPECT_EQ(d.initial.velocity, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(d.initial.angular_velocity, Eigen::Vector3d(0, 0, 4));
+  EXPECT_EQ(d.initial.center, Eigen::Vector3d(0.1, 0.2, 0.3));
+  EXPECT_TRUE(s.write_obj_frames);
+
+  // The shared part is the same as the static problem's.
+  EXPECT_EQ(d.mesh.vertices, s.problem.mesh.vertices);
+  EXPECT_EQ(d.mesh.num_triangles(), s.problem.mesh.num_triangles());
+  EXPECT_DOUBLE_EQ(d.material.stretch_modulus, 5000.0);
+  EXPECT_DOUBLE_EQ(d.material.areal_density, 0.1238);
+  EXPECT_EQ(d.gravity, Eigen::Vector3d(0, 0, -9.81));
+  EXPECT_DOUBLE_EQ(d.pressure, 2.0);
+  ASSERT_EQ(d.point_loads.size(), 1u);
+  EXPECT_EQ(d.point_loads[0].vertex, s.problem.point_loads[0].vertex);
+  EXPECT_EQ(d.quadrature, Quadrature::three_point);
+
+  ASSERT_EQ(d.boundary.size(), 2u);
+  EXPECT_EQ(d.boundary[0].vertices, s.problem.boundary[0].vertices);
+  EXPECT_EQ(d.boundary[0].vertices.size(), 5u);
+  EXPECT_EQ(d.boundary[1].fix, (std::array<bool, 3>{false, false, true}));
+  EXPECT_TRUE(d.boundary[1].motion.empty());
+  const std::vector<Motion>& m = d.boundary[0].motion;
+  ASSERT_EQ(m.size(), 3u);
+  EXPECT_EQ(m[0].type, Motion::Type::rotate);
+  EXPECT_EQ(m[0].axis, Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(m[0].center, Eigen::Vector3d::Zero());
+  EXPECT_DOUBLE_EQ(m[0].angle_deg, 180.0);
+  EXPECT_DOUBLE_EQ(m[0].start, 0.0);
+  EXPECT_DOUBLE_EQ(m[0].end, 1.0);
+  EXPECT_EQ(m[1].type, Motion::Type::translate);
+  EXPECT_EQ(m[1].displacement, Eigen::Vector3d(0, 0.05, 0));
+  EXPECT_DOUBLE_EQ(m[1].start, 1.0);
+  EXPECT_DOUBLE_EQ(m[1].end, 2.0);
+  EXPECT_EQ(m[2].type, Motion::Type::hold);
+  EXPECT_DOUBLE_EQ(m[2].start, 2.0);
+  EXPECT_DOUBLE_EQ(m[2].end, 3.0);
+}
+
+TEST_F(SceneLoader, DynamicDefaults) {
+  const Scene s = load(std::string(R"({"analysis": "dynamic", )") + kGrid4 +
+                       R"(, "boundary": [{"select": {"box": [[-1, -0.51, -1], [1, -0.49, 1]]},
+      "motion": [{"type": "rotate", "axis": [0, 0, 2], "angle_deg": 30, "start": 0.5, "end": 0.5}]}]})");
+  const DynamicProblem& d = s.dynamic;
+  EXPECT_DOUBLE_EQ(d.time.dt, 0.001);
+  EXPECT_DOUBLE_EQ(d.time.end, 1.0);
+  EXPECT_DOUBLE_EQ(d.time.output_fps, 30.0);
+  EXPECT_DOUBLE_EQ(d.damping.stiffness, 0.0);
+  EXPECT_DOUBLE_EQ(d.damping.mass, 0.0);
+  EXPECT_EQ(d.solver.type, LinearSolverType::pcg);
+  EXPECT_DOUBLE_EQ(d.solver.tolerance, 1e-8);
+  EXPECT_EQ(d.solver.max_iterations, 2000);
+  EXPECT_EQ(d.solver.newton_iterations, 1);
+  EXPECT_TRUE(d.corotational);
+  EXPECT_EQ(d.initial.velocity, Eigen::Vector3d::Zero());
+  EXPECT_EQ(d.initial.angular_velocity, Eigen::Vector3d::Zero());
+  EXPECT_EQ(d.initial.center, Eigen::Vector3d::Zero());
+  EXPECT_FALSE(s.write_obj_frames);
+  EXPECT_EQ(d.mesh.vertices, s.problem.mesh.vertices);
+  ASSERT_EQ(d.boundary.size(), 1u);
+  ASSERT_EQ(d.boundary[0].motion.size(), 1u);
+  const Motion& m = d.boundary[0].motion[0];
+  EXPECT_EQ(m.type, Motion::Type::rotate);
+  EXPECT_EQ(m.center, Eigen::Vector3d::Zero());  // center defaults to the origin
+  EXPECT_EQ(m.axis, Eigen::Vector3d(0, 0, 2));
+  EXPECT_DOUBLE_EQ(m.start, 0.5);                // a jump (start == end) is allowed
+  EXPECT_DOUBLE_EQ(m.end, 0.5);
+
+  // "output": {} and "obj": false leave frames off; the default material has mass.
+  EXPECT_FALSE(load(std::string(R"({"analysis": "dynamic", "output": {}, )") + kGrid4 + "}").write_obj_frames);
+  EXPECT_FALSE(load(std::string(R"({"analysis": "dynamic", "output": {"obj": false}, )") + kGrid4 + "}").write_obj_frames);
+  EXPECT_GT(load(std::string(R"({"analysis": "dynamic", )") + kGrid4 + "}").dynamic.material.areal_density, 0.0);
+
+  // A static scene leaves the dynamic part at its defaults.
+  const Scene t = load(std::string("{") + kGrid4 + "}");
+  EXPECT_EQ(t.dynamic.mesh.num_vertices(), 0);
+  EXPECT_FALSE(t.write_obj_frames);
+}
+
+TEST_F(SceneLoader, DynamicKeysRejectedInStaticScene) {
+  const std::string needs = ": needs \"analysis\": \"dynamic\" (this scene is static)";
+  for (const std::string item : {R"("time": {"dt": 0.01})", R"("damping": {})", R"("solver": {"type": "pcg"})",
+                                 R"("corotational": true)", R"("initial": {})", R"("output": {"obj": true})"}) {
+    const std::string key = item.substr(1, item.find('"', 1) - 1);
+    EXPECT_EQ(error(std::string("{") + kGrid4 + ", " + item + "}"), expected(key + needs)) << item;
+    EXPECT_EQ(error(std::string(R"({"analysis": "static", )") + kGrid4 + ", " + item + "}"), expected(key + needs))
+        << item;
+  }
+  EXPECT_EQ(error(std::string("{") + kGrid4 + R"(, "boundary": [{"select": {"box": [[-1, -1, -1], [1, 1, 1]]},
+      "motion": [{"type": "hold", "start": 0, "end": 1}]}]})"),
+            expected("boundary[0].motion" + needs));
+  // Unknown keys are still unknown, not "dynamic only".
+  EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "timestep": 0.01})"),
+                       expected("timestep: unknown key (allowed: name, description, analysis, mesh, material, boundary, "
+                                "loads, probes, numerics, time, damping, solver, corotational, initial, output)")));
+}
+
+TEST_F(SceneLoader, DynamicSettingErrors) {
+  auto with = [&](const std::string& rest) {
+    return error(std::string(R"({"analysis": "dynamic", )") + kGrid4 + ", " + rest + "}");
+  };
+  EXPECT_EQ(with(R"("time": {"dt": 0})"), expected("time.dt: must be > 0 [s] (got 0)"));
+  EXPECT_EQ(with(R"("time": {"end": -1})"), expected("time.end: must be > 0 [s] (got -1)"));
+  EXPECT_EQ(with(R"("time": {"dt": 0.1, "end": 0.05})"), expected("time.end: must be >= time.dt = 0.1 [s] (got 0.05)"));
+  EXPECT_EQ(with(R"("time": {"dt": 2})"), expected("time.end: must be >= time.dt = 2.0 [s] (got 1.0)"));
+  EXPECT_EQ(with(R"("time": {"output_fps": 0})"), expected("time.output_fps: must be > 0 [1/s] (got 0)"));
+  EXPECT_TRUE(contains(with(R"("time": {"dt": "1ms"})"), expected("time.dt: expected a number")));
+  EXPECT_TRUE(contains(with(R"("time": {"step": 0.01})"), expected("time.step: unknown key (allowed: dt, end, output_fps)")));
+  EXPECT_EQ(with(R"("damping": {"stiffness": -0.1})"), expected("damping.stiffness: must be >= 0 [s] (got -0.1)"));
+  EXPECT_EQ(with(R"("damping": {"mass": -1})"), expected("damping.mass: must be >= 0 [1/s] (got -1)"));
+  EXPECT_TRUE(contains(with(R"("damping": {"alpha": 1})"), expected("damping.alpha: unknown key (allowed: stiffness, mass)")));
+  EXPECT_EQ(with(R"("solver": {"type": "gmres"})"),
+            expected("solver.type: unknown solver type \"gmres\" (allowed: \"pcg\", \"cholmod\")"));
+  EXPECT_EQ(with(R"("solver": {"tolerance": 1})"), expected("solver.tolerance: must be > 0 and < 1 (got 1)"));
+  EXPECT_EQ(with(R"("solver": {"tolerance": 0})"), expected("solver.tolerance: must be > 0 and < 1 (got 0)"));
+  EXPECT_EQ(with(R"("solver": {"max_iterations": 0})"), expected("solver.max_iterations: must be an integer >= 1 (got 0)"));
+  EXPECT_EQ(with(R"("solver": {"newton_iterations": 0})"),
+            expected("solver.newton_iterations: must be an integer >= 1 (got 0)"));
+  EXPECT_TRUE(contains(with(R"("solver": {"max_iterations": 10.5})"), expected("solver.max_iterations: expected an integer")));
+  EXPECT_TRUE(contains(with(R"("solver": {"preconditioner": "jacobi"})"),
+                       expected("solver.preconditioner: unknown key (allowed: type, tolerance, max_iterations, "
+                                "newton_iterations)")));
+  EXPECT_EQ(with(R"("corotational": "yes")"), expected("corotational: expected true or false (got \"yes\")"));
+  EXPECT_EQ(with(R"("corotational": 1)"), expected("corotational: expected true or false (got 1)"));
+  EXPECT_TRUE(contains(with(R"("initial": {"velocity": [0, 0]})"), expected("initial.velocity: expected an array of 3 numbers")));
+  EXPECT_TRUE(contains(with(R"("initial": {"angular_velocity": "spin"})"),
+                       expected("initial.angular_velocity: expected an array of 3 numbers")));
+  EXPECT_TRUE(contains(with(R"("initial": {"omega": [0, 0, 1]})"),
+                       expected("initial.omega: unknown key (allowed: velocity, angular_velocity, center)")));
+  EXPECT_EQ(with(R"("output": {"obj": "yes"})"), expected("output.obj: expected true or false (got \"yes\")"));
+  EXPECT_TRUE(contains(with(R"("output": {"vtk": true})"), expected("output.vtk: unknown key (allowed: obj)")));
+  EXPECT_TRUE(contains(with(R"("output": true)"), expected("output: expected an object")));
+  EXPECT_TRUE(contains(with(R"("material": {"density": 0})"),
+                       expected("material: a dynamic analysis needs a positive areal density (mass) [kg/m²] (got 0.0)")));
+  EXPECT_TRUE(contains(with(R"("material": {"preset": "cotton", "areal_density": 0})"),
+                       expected("material: a dynamic analysis needs a positive areal density")));
+}
+
+TEST_F(SceneLoader, MotionErrors) {
+  auto motion = [&](const std::string& list, const std::string& fix = R"(["x", "y", "z"])") {
+    return error(std::string(R"({"analysis": "dynamic", )") + kGrid4 +
+                 R"(, "boundary": [{"select": {"box": [[-1, -1, -1], [1, 1, 1]]}, "fix": )" + fix +
+                 R"(, "motion": )" + list + "}]}");
+  };
+  const std::string m0 = "boundary[0].motion[0]";
+  EXPECT_TRUE(contains(motion(R"({"type": "hold"})"), expected("boundary[0].motion: expected an array")));
+  EXPECT_TRUE(contains(motion("[3]"), expected(m0 + ": expected an object (got 3)")));
+  EXPECT_EQ(motion(R"([{"start": 0, "end": 1}])"), expected(m0 + ".type: required key is missing"));
+  EXPECT_EQ(motion(R"([{"type": "spin", "start": 0, "end": 1}])"),
+            expected(m0 + ".type: unknown motion type \"spin\" (allowed: \"rotate\", \"translate\", \"hold\")"));
+  EXPECT_EQ(motion(R"([{"type": "hold", "start": 0}])"), expected(m0 + ".end: required key is missing"));
+  EXPECT_EQ(motion(R"([{"type": "hold", "end": 1}])"), expected(m0 + ".start: required key is missing"));
+  EXPECT_EQ(motion(R"([{"type": "hold", "start": -0.5, "end": 1}])"), expected(m0 + ".start: must be >= 0 [s] (got -0.5)"));
+  EXPECT_EQ(motion(R"([{"type": "hold", "start": 2, "end": 1}])"), expected(m0 + ".end: must be >= start = 2.0 [s] (got 1.0)"));
+  EXPECT_EQ(motion(R"([{"type": "rotate", "angle_deg": 90, "start": 0, "end": 1}])"),
+            expected(m0 + ".axis: required key is missing"));
+  EXPECT_EQ(motion(R"([{"type": "rotate", "axis": [0, 0, 0], "angle_deg": 90, "start": 0, "end": 1}])"),
+            expected(m0 + ".axis: must be a non-zero vector (got [0.0, 0.0, 0.0])"));
+  EXPECT_EQ(motion(R"([{"type": "rotate", "axis": [0, 1, 0], "start": 0, "end": 1}])"),
+            expected(m0 + ".angle_deg: required key is missing"));
+  EXPECT_TRUE(contains(motion(R"([{"type": "rotate", "axis": [0, 1, 0], "center": [0, 0], "angle_deg": 9, "start": 0, "end": 1}])"),
+                       expected(m0 + ".center: expected an array of 3 numbers")));
+  EXPECT_EQ(motion(R"([{"type": "translate", "start": 0, "end": 1}])"), expected(m0 + ".displacement: required key is missing"));
+  EXPECT_EQ(motion(R"([{"type": "translate", "displacement": [0, 1, 0], "axis": [0, 1, 0], "start": 0, "end": 1}])"),
+            expected(m0 + ".axis: unknown key (allowed: type, displacement, start, end)"));
+  EXPECT_EQ(motion(R"([{"type": "hold", "angle_deg": 3, "start": 0, "end": 1}])"),
+            expected(m0 + ".angle_deg: unknown key (allowed: type, start, end)"));
+  EXPECT_EQ(motion(R"([{"type": "rotate", "axis": [0, 1, 0], "angle_deg": 9, "start": 0, "end": 1, "speed": 2}])"),
+            expected(m0 + ".speed: unknown key (allowed: type, axis, center, angle_deg, start, end)"));
+  EXPECT_EQ(motion(R"([{"type": "hold", "start": 0, "end": 1}, {"type": "hold", "start": 1}])"),
+            expected("boundary[0].motion[1].end: required key is missing"));
+  EXPECT_TRUE(contains(motion(R"([{"type": "hold", "start": 0, "end": 1}])", "[]"),
+                       expected("boundary[0].motion: has no effect")));
+  // An empty chain is allowed (the components stay at rest) and so is a partial fix.
+  EXPECT_EQ(motion("[]"), "no error");
+  EXPECT_EQ(motion(R"([{"type": "translate", "displacement": [0, 1, 0], "start": 0, "end": 1}])", R"(["y"])"), "no error");
+}
+
+// ---- Shipped scenes -------------------------------------------------------------------------
+
+TEST_F(SceneLoader, EveryShippedSceneLoads) {
+  const fs::path scenes = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(scenes))
+    if (entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
+  std::sort(names.begin(), names.end());
+  for (const std::string name :
+       {"cantilever", "cylinder_pressure", "fig8_thick", "fig8_thick_stiff", "fig8_thin", "metal_compress",
+        "pinched_cylinder", "plate_clamped", "plate_ss", "scordelis_lo", "sleeve_compress", "sleeve_compress_2542",
+        "sleeve_gravity", "sleeve_twist"})
+    EXPECT_TRUE(std::binary_search(names.begin(), names.end(), name)) << "missing scenes/" << name << ".json";
+  for (const std::string& name : names) {
+    SCOPED_TRACE(name);
+    Scene s;
+    try {
+      s = load_scene(scenes / (name + ".json"), nullptr);
+    } catch (const SceneError& e) {
+      ADD_FAILURE() << e.what();
+      continue;
+    }
+    EXPECT_EQ(s.name, name);
+    EXPECT_FALSE(s.description.empty());
+    EXPECT_FALSE(s.probes.empty());
+  }
+}
+
+TEST_F(SceneLoader, ShippedSleeveScenes) {
+  const fs::path scenes = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
+  const double length = 0.2;
+  struct Expect {
+    std::string name;
+    int vertices;
+    int triangles;
+    double dt;
+    double end;
+    std::string motion;  // "", "rotate" or "translate" on the top rim
+  };
+  for (const Expect& e : std::vector<Expect>{{"sleeve_gravity", 494, 936, 0.001, 1.0, ""},
+                                             {"sleeve_twist", 494, 936, 0.001, 1.5, "rotate"},
+                                             {"sleeve_compress", 494, 936, 0.001, 1.5, "translate"},
+                                             {"sleeve_compress_2542", 2542, 4960, 0.01, 1.0, "translate"},
+                                             {"metal_compress", 494, 936, 0.001, 1.5, "translate"},
+                                             {"fig8_thin", 780, 1500, 0.001, 1.5, "rotate"},
+                                             {"fig8_thick", 780, 1500, 0.001, 1.5, "rotate"},
+                                             {"fig8_thick_stiff", 780, 1500, 0.001, 1.5, "rotate"}}) {
+    SCOPED_TRACE(e.name);
+    const Scene s = load_scene(scenes / (e.name + ".json"), nullptr);
+    const DynamicProblem& d = s.dynamic;
+    EXPECT_EQ(s.analysis, "dynamic");
+    EXPECT_TRUE(s.write_obj_frames);
+    EXPECT_EQ(d.mesh.num_vertices(), e.vertices);
+    EXPECT_EQ(d.mesh.num_triangles(), e.triangles);
+    EXPECT_DOUBLE_EQ(d.time.dt, e.dt);
+    EXPECT_DOUBLE_EQ(d.time.end, e.end);
+    EXPECT_TRUE(d.corotational);
+    const int per_ring = e.vertices == 494 ? 26 : (e.vertices == 2542 ? 62 : 30);
+    // Every boundary condition holds one whole rim in x, y and z.
+    for (const BoundaryCondition& bc : d.boundary) {
+      EXPECT_EQ(bc.fix, (std::array<bool, 3>{true, true, true}));
+      ASSERT_EQ(static_cast<int>(bc.vertices.size()), per_ring);
+      const double y = d.mesh.vertices(bc.vertices[0], 1);
+      EXPECT_TRUE(std::abs(y) < 1e-12 || std::abs(y - length) < 1e-12) << y;
+      for (int v : bc.vertices) EXPECT_NEAR(d.mesh.vertices(v, 1), y, 1e-12);
+    }
+    if (e.motion.empty()) {
+      ASSERT_EQ(d.boundary.size(), 1u);  // the top rim only, under gravity
+      EXPECT_NEAR(d.mesh.vertices(d.boundary[0].vertices[0], 1), length, 1e-12);
+      EXPECT_EQ(d.gravity, Eigen::Vector3d(0, -9.81, 0));
+      continue;
+    }
+    EXPECT_EQ(d.gravity, Eigen::Vector3d::Zero());
+    ASSERT_EQ(d.boundary.size(), 2u);
+    EXPECT_TRUE(d.boundary[0].motion.empty());
+    ASSERT_EQ(d.boundary[1].motion.size(), 1u);
+    EXPECT_NEAR(d.mesh.vertices(d.boundary[1].vertices[0], 1), length, 1e-12);
+    const Motion& m = d.boundary[1].motion[0];
+    EXPECT_DOUBLE_EQ(m.start, 0.0);
+    EXPECT_DOUBLE_EQ(m.end, 1.0);
+    if (e.motion == "rotate") {
+      EXPECT_EQ(m.type, Motion::Type::rotate);
+      EXPECT_EQ(m.axis, Eigen::Vector3d(0, 1, 0));
+      EXPECT_DOUBLE_EQ(m.angle_deg, 90.0);
+    } else {
+      EXPECT_EQ(m.type, Motion::Type::translate);
+      EXPECT_LT((m.displacement - Eigen::Vector3d(0, -0.3 * length, 0)).norm(), 1e-15);
+    }
+  }
+
+  const ShellMaterial cotton = *material_preset("cotton");
+  auto material = [&](const std::string& name) { return load_scene(scenes / (name + ".json"), nullptr).dynamic.material; };
+  EXPECT_DOUBLE_EQ(material("sleeve_gravity").bending_rigidity, cotton.bending_rigidity);
+  EXPECT_DOUBLE_EQ(material("metal_compress").stretch_modulus, 1e5);
+  const ShellMaterial thin = material("fig8_thin"), thick = material("fig8_thick"), stiff = material("fig8_thick_stiff");
+  EXPECT_DOUBLE_EQ(thin.bending_rigidity, cotton.bending_rigidity);
+  EXPECT_DOUBLE_EQ(thin.stretch_modulus, cotton.stretch_modulus);
+  EXPECT_NEAR(thick.bending_rigidity, 100 * cotton.bending_rigidity, 1e-15);
+  EXPECT_DOUBLE_EQ(thick.stretch_modulus, cotton.stretch_modulus);
+  EXPECT_NEAR(stiff.bending_rigidity, 100 * cotton.bending_rigidity, 1e-15);
+  EXPECT_DOUBLE_EQ(stiff.stretch_modulus, 10 * cotton.stretch_modulus);
+  EXPECT_DOUBLE_EQ(thick.areal_density, cotton.areal_density);
 }
 
 }  // namespace

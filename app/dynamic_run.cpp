@@ -1,0 +1,336 @@
+// The dynamic part of the clothsim command: builds the Simulator, then steps it while streaming
+// probes.csv, stats.csv and OBJ frames (flushed every step, so a failed or interrupted run keeps
+// what it has written) and finally summary.json (replaced atomically).
+#include "app/dynamic_run.hpp"
+
+#include "sim/dynamics/simulator.hpp"
+#include "sim/mesh/obj_io.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace clothsim {
+namespace {
+
+namespace fs = std::filesystem;
+using OrderedJson = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+void log_line(const std::string& line) { std::cerr << "clothsim: " << line << '\n'; }
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Shortest decimal form that reads back to the identical double.
+std::string format_double(double v) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), v);
+  return std::string(buffer, result.ptr);
+}
+
+// Short human form for log lines.
+std::string format_short(double v) {
+  std::ostringstream s;
+  s << std::setprecision(6) << v;
+  return s.str();
+}
+
+// A CSV field (RFC 4180): quoted, with doubled quotes, when it holds a comma, quote or newline.
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) q += (c == '"') ? std::string("\"\"") : std::string(1, c);
+  return q + "\"";
+}
+
+// A text file written line by line and flushed on demand; every failure throws naming the file.
+class StreamFile {
+ public:
+  explicit StreamFile(fs::path path) : path_(std::move(path)), out_(path_, std::ios::binary) {
+    if (!out_) throw std::runtime_error(path_.string() + ": cannot open the file for writing");
+  }
+  void line(const std::string& text) { out_ << text << '\n'; }
+  void flush() {
+    out_.flush();
+    if (!out_) throw std::runtime_error(path_.string() + ": cannot write the file");
+  }
+
+ private:
+  fs::path path_;
+  std::ofstream out_;
+};
+
+// Writes `text` to `path` through a temporary sibling and a rename, so a reader never sees a
+// half-written file.
+void write_atomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp");
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw std::runtime_error(tmp.string() + ": cannot write the file");
+  }
+  fs::rename(tmp, path);
+}
+
+// The missing ancestors of `dir` (deepest first), i.e. the folders create_directories(dir) makes.
+std::vector<fs::path> missing_folders(const fs::path& dir) {
+  std::vector<fs::path> missing;
+  std::error_code ec;
+  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  return missing;
+}
+
+// Creates a fresh, empty `root/<name>`. An older folder of that name is first renamed to
+// `root/.<name>.old-<pid>` and deleted once the new one exists (restored if creating it fails).
+// On failure removes the folders it created and throws.
+fs::path create_output_folder(const fs::path& root, const std::string& name) {
+  const fs::path final_dir = root / name;
+  const fs::path old = root / ("." + name + ".old-" + std::to_string(static_cast<long>(::getpid())));
+  const std::vector<fs::path> created = missing_folders(root);
+  std::error_code ec;
+  bool replacing = false;
+  try {
+    fs::create_directories(root);
+    replacing = fs::exists(fs::symlink_status(final_dir));
+    if (replacing) {
+      fs::remove_all(old);
+      fs::rename(final_dir, old);
+    }
+    fs::create_directory(final_dir);
+  } catch (...) {
+    if (replacing && !fs::exists(fs::symlink_status(final_dir, ec))) fs::rename(old, final_dir, ec);
+    for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if empty
+    throw;
+  }
+  if (replacing && fs::remove_all(old, ec) == static_cast<std::uintmax_t>(-1))
+    log_line("warning: could not remove the previous output " + old.string() + ": " + ec.message());
+  return final_dir;
+}
+
+// Warnings about the settings, for the log and summary.json.
+std::vector<std::string> settings_warnings(const Scene& scene, int steps) {
+  std::vector<std::string> warnings;
+  const TimeSettings& time = scene.dynamic.time;
+  const double last = steps * time.dt;
+  if (std::abs(last - time.end) > 1e-9 * time.dt)
+    warnings.push_back("time.end = " + format_double(time.end) + " s is not a multiple of time.dt = " +
+                       format_double(time.dt) + " s; the run ends at t = " + format_double(last) + " s");
+  if (scene.write_obj_frames && time.output_fps * time.dt > 1.0 + 1e-9)
+    warnings.push_back("time.output_fps = " + format_double(time.output_fps) + " exceeds 1/dt = " +
+                       format_double(1.0 / time.dt) + "; some frames repeat the previous one");
+  if (scene.probes.empty()) warnings.push_back("the scene has no probes; probes.csv holds only its header");
+  return warnings;
+}
+
+// Running totals for summary.json.
+struct RunTotals {
+  int steps = 0;
+  double t = 0.0;
+  double rotate_ms = 0.0, assemble_ms = 0.0, solve_ms = 0.0;
+  int frames = 0;
+  int max_solver_iterations = 0;
+};
+
+std::string summary_json(const Scene& scene, const RunTotals& totals, double wall_seconds,
+                         const std::vector<std::string>& warnings, const std::string& status,
+                         const std::string& error) {
+  OrderedJson j = {{"scene", scene.name},
+                   {"analysis", "dynamic"},
+                   {"steps", totals.steps},
+                   {"simulated_time", totals.t},
+                   {"wall_seconds", wall_seconds},
+                   {"seconds",
+                    {{"rotate", totals.rotate_ms / 1000.0},
+                     {"assemble", totals.assemble_ms / 1000.0},
+                     {"solve", totals.solve_ms / 1000.0}}},
+                   {"frames", totals.frames},
+                   {"max_solver_iterations", totals.max_solver_iterations},
+                   {"warnings", warnings},
+                   {"status", status}};
+  if (!error.empty()) j["error"] = error;
+  return j.dump(2) + "\n";
+}
+
+// The streamed outputs of one run.
+class Outputs {
+ public:
+  Outputs(const Scene& scene, const fs::path& dir)
+      : scene_(scene), dir_(dir), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
+    probes_.line("step,t,name,ux,uy,uz");
+    stats_.line("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy");
+    probes_.flush();
+    stats_.flush();
+    if (scene.write_obj_frames) fs::create_directory(dir / "frames");
+  }
+
+  // Probe rows and due frames for the state reached after `step` steps, at time `t` [s].
+  void record_state(const Simulator& sim, int step, double t, RunTotals& totals) {
+    const TimeSettings& time = scene_.dynamic.time;
+    const bool frame_due = scene_.write_obj_frames &&
+                           t >= totals.frames / time.output_fps - 1e-9 * time.dt;
+    if (scene_.probes.empty() && !frame_due) return;
+    const Eigen::MatrixX3d limit = sim.limit_positions();
+    if (!scene_.probes.empty()) {
+      const Eigen::MatrixX3d& rest = sim.limit_rest();
+      std::string prefix = std::to_string(step);
+      prefix.append(1, ',').append(format_double(t)).append(1, ',');
+      for (const Probe& p : scene_.probes) {
+        std::string row = prefix + csv_field(p.name);
+        for (int k = 0; k < 3; ++k) row.append(1, ',').append(format_double(limit(p.vertex, k) - rest(p.vertex, k)));
+        probes_.line(row);
+      }
+      probes_.flush();
+    }
+    // Frame k belongs to the first state with t >= k / fps; a step longer than a frame period
+    // repeats the frame so that frame k always shows time ≈ k / fps.
+    while (scene_.write_obj_frames && t >= totals.frames / time.output_fps - 1e-9 * time.dt) {
+      char file[32];
+      std::snprintf(file, sizeof(file), "mesh_%04d.obj", totals.frames);
+      const std::string comment = "clothsim: limit surface of scene " + scene_.name + ", frame " +
+                                  std::to_string(totals.frames) + ", step " + std::to_string(step) +
+                                  ", t = " + format_double(t) + " s";
+      write_obj((dir_ / "frames" / file).string(), limit, scene_.dynamic.mesh.triangles, comment);
+      ++totals.frames;
+    }
+  }
+
+  void record_stats(const StepStats& s) {
+    std::string row = std::to_string(s.step);
+    for (const std::string& field :
+         {format_double(s.t), std::to_string(s.solver_iterations), format_double(s.residual),
+          format_double(s.rotate_ms), format_double(s.assemble_ms), format_double(s.solve_ms),
+          format_double(s.kinetic_energy), format_double(s.elastic_energy)})
+      row.append(1, ',').append(field);
+    stats_.line(row);
+    stats_.flush();
+  }
+
+ private:
+  const Scene& scene_;
+  fs::path dir_;
+  StreamFile probes_;
+  StreamFile stats_;
+};
+
+void print_summary(const Scene& scene, const Simulator& sim, const RunTotals& totals, double wall_seconds,
+                   const fs::path& dir) {
+  std::ostringstream s;
+  s << std::setprecision(6);
+  s << "scene " << scene.name << " (dynamic)\n";
+  s << "  control vertices " << scene.dynamic.mesh.num_vertices() << ", triangles "
+    << scene.dynamic.mesh.num_triangles() << "\n";
+  s << "  steps " << totals.steps << " of dt = " << scene.dynamic.time.dt << " s, simulated time " << totals.t
+    << " s, wall time " << wall_seconds << " s (rotate " << totals.rotate_ms / 1000.0 << " s, assemble "
+    << totals.assemble_ms / 1000.0 << " s, solve " << totals.solve_ms / 1000.0 << " s)\n";
+  s << "  max solver iterations per step " << totals.max_solver_iterations << "\n";
+  if (!scene.probes.empty()) {
+    const Eigen::MatrixX3d u = sim.limit_positions() - sim.limit_rest();
+    for (const Probe& p : scene.probes)
+      s << "  probe " << p.name << " (vertex " << p.vertex << "): final displacement [" << u(p.vertex, 0) << ", "
+        << u(p.vertex, 1) << ", " << u(p.vertex, 2) << "] m\n";
+  }
+  s << "  wrote " << (dir / "probes.csv").string() << ", stats.csv, summary.json";
+  if (scene.write_obj_frames) s << " and " << totals.frames << " frames in frames/";
+  s << "\n";
+  std::cout << s.str() << std::flush;
+}
+
+}  // namespace
+
+int run_dynamic_scene(const Scene& scene, const fs::path& out_root) {
+  const std::string file = scene.file.string();
+  const Clock::time_point start = Clock::now();
+
+  // Everything that can fail before the first step fails here, before any file is written.
+  std::unique_ptr<Simulator> sim;
+  try {
+    sim = std::make_unique<Simulator>(scene.dynamic);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(file + ": cannot set up the dynamic analysis: " + e.what());
+  }
+  const int steps = sim->num_steps();
+  const std::vector<std::string> warnings = settings_warnings(scene, steps);
+  for (const std::string& w : warnings) log_line("warning: " + w);
+  log_line("dynamic analysis: " + std::to_string(steps) + " steps of dt = " + format_short(scene.dynamic.time.dt) +
+           " s to t = " + format_short(scene.dynamic.time.end) + " s");
+
+  fs::path dir;
+  try {
+    dir = create_output_folder(out_root, scene.name);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot create the output folder " + (out_root / scene.name).string() + ": " + e.what());
+  }
+
+  RunTotals totals;
+  std::string failure;  // the error message of a failed run
+  try {
+    write_atomically(dir / "summary.json", summary_json(scene, totals, seconds_since(start), warnings, "running", ""));
+    Outputs outputs(scene, dir);
+    outputs.record_state(*sim, 0, sim->state().t, totals);
+    const int progress_every = std::max(1, (steps + 9) / 10);
+    for (int k = 1; k <= steps; ++k) {
+      try {
+        const StepStats s = sim->step();
+        totals.steps = s.step;
+        totals.t = s.t;
+        totals.rotate_ms += s.rotate_ms;
+        totals.assemble_ms += s.assemble_ms;
+        totals.solve_ms += s.solve_ms;
+        totals.max_solver_iterations = std::max(totals.max_solver_iterations, s.solver_iterations);
+        outputs.record_stats(s);
+        outputs.record_state(*sim, s.step, s.t, totals);
+      } catch (const SimulationError&) {
+        throw;
+      } catch (const std::exception& e) {
+        // Name the step for any other failure (write errors, solver exceptions), as SimulationError does.
+        throw SimulationError(k, k * scene.dynamic.time.dt, e.what());
+      }
+      if (k % progress_every == 0 || k == steps)
+        log_line("step " + std::to_string(k) + "/" + std::to_string(steps) + " (" +
+                 std::to_string(static_cast<long long>(100.0 * k / steps)) + "%), t = " + format_short(totals.t) +
+                 " s, wall " + format_short(seconds_since(start)) + " s");
+    }
+  } catch (const std::exception& e) {
+    failure = e.what();
+  }
+
+  const double wall = seconds_since(start);
+  try {
+    write_atomically(dir / "summary.json", summary_json(scene, totals, wall, warnings,
+                                                        failure.empty() ? "completed" : "failed", failure));
+  } catch (const std::exception& e) {
+    if (failure.empty()) failure = e.what();
+    else log_line("warning: " + std::string(e.what()));
+  }
+  if (!failure.empty()) {
+    std::cerr << "clothsim: error: " << file << ": " << failure << '\n';
+    log_line("kept the outputs written so far in " + dir.string());
+    return 1;
+  }
+  print_summary(scene, *sim, totals, wall, dir);
+  return 0;
+}
+
+}  // namespace clothsim

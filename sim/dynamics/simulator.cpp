@@ -1,0 +1,280 @@
+#include "sim/dynamics/simulator.hpp"
+
+#include "sim/dynamics/corotation.hpp"
+#include "sim/shell/shell_model.hpp"
+#include "sim/solver/direct_solver.hpp"
+#include "sim/solver/pcg.hpp"
+
+#include <Eigen/Geometry>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+namespace clothsim {
+
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+Eigen::VectorXd flat(const Eigen::MatrixX3d& m) {
+  Eigen::VectorXd out(3 * m.rows());
+  for (Eigen::Index v = 0; v < m.rows(); ++v) out.segment<3>(3 * v) = m.row(v).transpose();
+  return out;
+}
+
+Eigen::MatrixX3d unflat(const Eigen::VectorXd& f) {
+  return Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(f.data(), f.size() / 3, 3);
+}
+
+void check_problem(const DynamicProblem& p) {
+  if (const std::string bad = validate(p.material); !bad.empty()) throw std::runtime_error("material: " + bad);
+  if (!(p.material.areal_density > 0))
+    throw std::runtime_error("material: a dynamic analysis needs a positive areal density (mass) [kg/m²]");
+  if (!(std::isfinite(p.time.dt) && p.time.dt > 0)) throw std::runtime_error("time.dt must be > 0 [s]");
+  if (!(std::isfinite(p.time.end) && p.time.end > 0)) throw std::runtime_error("time.end must be > 0 [s]");
+  if (!(p.damping.stiffness >= 0 && p.damping.mass >= 0)) throw std::runtime_error("damping must be >= 0");
+  if (!(p.solver.tolerance > 0 && p.solver.tolerance < 1)) throw std::runtime_error("solver.tolerance must lie in (0, 1)");
+  if (p.solver.max_iterations < 1 || p.solver.newton_iterations < 1)
+    throw std::runtime_error("solver.max_iterations and solver.newton_iterations must be >= 1");
+  for (size_t i = 0; i < p.boundary.size(); ++i)
+    for (size_t k = 0; k < p.boundary[i].motion.size(); ++k)
+      if (const std::string bad = validate(p.boundary[i].motion[k]); !bad.empty())
+        throw std::runtime_error("boundary[" + std::to_string(i) + "].motion[" + std::to_string(k) + "]: " + bad);
+  const int n = p.mesh.num_vertices();
+  for (const PointLoad& l : p.point_loads)
+    if (l.vertex < 0 || l.vertex >= n) throw std::runtime_error("point load at vertex " + std::to_string(l.vertex) + ": no such vertex");
+}
+
+}  // namespace
+
+struct Simulator::Impl {
+  DynamicProblem problem;
+  ShellModel model;
+  int n = 0;
+  Eigen::VectorXd rest;     // 3n rest positions
+  Eigen::VectorXd mass;     // 3n lumped mass per DOF [kg]
+  Eigen::VectorXd mass_per_vertex;
+  Eigen::VectorXd f_ext;    // 3n constant external force [N]
+  CorotationalElements elements;
+  std::vector<char> solve_free;            // 3n: unknown in the linear solve
+  std::vector<int> prescribed_dof;         // fixed components: DOF ids
+  std::vector<const std::vector<Motion>*> prescribed_motion;  // their motion chain (may be empty)
+  std::vector<int> dependent_dof;          // tied components (clamped borders)
+  DirectSolver direct;
+  DynamicState state;
+  Eigen::MatrixX3d limit_rest;
+  double work = 0.0;
+  double bbox = 1.0;
+
+  explicit Impl(const DynamicProblem& p)
+      : problem(p),
+        model(p.mesh, p.material, p.boundary, p.quadrature),
+        n(p.mesh.num_vertices()),
+        elements(model, p.corotational),
+        direct(/*supernodal=*/3 * p.mesh.num_vertices() > 30000) {}
+
+  // Real displacement vector with the tied components derived from the others.
+  Eigen::VectorXd consistent(const Eigen::VectorXd& x) const {
+    Eigen::VectorXd u = x - rest;
+    for (int dof : dependent_dof) {
+      double value = 0.0;
+      for (const auto& [d, w] : model.dofs().combination(dof / 3, dof % 3)) value += w * u(d);
+      u(dof) = value;
+    }
+    return u;
+  }
+};
+
+Simulator::Simulator(const DynamicProblem& problem) {
+  check_problem(problem);
+  impl_ = std::make_unique<Impl>(problem);
+  Impl& m = *impl_;
+  const int n = m.n;
+  m.rest = flat(problem.mesh.vertices);
+  m.bbox = std::max((problem.mesh.vertices.colwise().maxCoeff() - problem.mesh.vertices.colwise().minCoeff()).norm(), 1e-12);
+
+  // Lumped mass: a third of each incident triangle's rest area.
+  m.mass_per_vertex = Eigen::VectorXd::Zero(n);
+  for (const Triangle& t : problem.mesh.triangles) {
+    const Eigen::Vector3d x0 = problem.mesh.vertices.row(t[0]), x1 = problem.mesh.vertices.row(t[1]),
+                          x2 = problem.mesh.vertices.row(t[2]);
+    const double area = 0.5 * (x1 - x0).cross(x2 - x0).norm();
+    for (int v : t) m.mass_per_vertex(v) += problem.material.areal_density * area / 3.0;
+  }
+  m.mass.resize(3 * n);
+  for (int v = 0; v < n; ++v) m.mass.segment<3>(3 * v).setConstant(m.mass_per_vertex(v));
+
+  // External loads: lumped gravity (consistent with the lumped mass, so free fall is exact),
+  // consistent surface loads and point loads.
+  m.f_ext = Eigen::VectorXd::Zero(3 * n);
+  for (int v = 0; v < n; ++v) m.f_ext.segment<3>(3 * v) = m.mass_per_vertex(v) * problem.gravity;
+  if (problem.surface_load.squaredNorm() > 0) m.f_ext += m.model.area_load(problem.surface_load);
+  if (problem.pressure != 0.0) m.f_ext += m.model.pressure_load(problem.pressure);
+  for (const PointLoad& l : problem.point_loads) m.f_ext += m.model.point_load(l.vertex, l.force);
+
+  // Which components the linear solve treats as unknown.
+  static const std::vector<Motion> kHold;
+  std::vector<const std::vector<Motion>*> motion_of(3 * n, nullptr);
+  for (const BoundaryCondition& bc : problem.boundary)
+    for (int v : bc.vertices)
+      for (int c = 0; c < 3; ++c)
+        if (bc.fix[c]) motion_of[3 * v + c] = &bc.motion;
+  m.solve_free.assign(3 * n, 1);
+  for (int v = 0; v < n; ++v)
+    for (int c = 0; c < 3; ++c) {
+      const int dof = 3 * v + c;
+      switch (m.model.dofs().status(v, c)) {
+        case DofStatus::free:
+          break;
+        case DofStatus::fixed:
+          m.solve_free[dof] = 0;
+          m.prescribed_dof.push_back(dof);
+          m.prescribed_motion.push_back(motion_of[dof] ? motion_of[dof] : &kHold);
+          break;
+        case DofStatus::dependent:
+          m.solve_free[dof] = 0;
+          m.dependent_dof.push_back(dof);
+          break;
+      }
+    }
+
+  // Initial state: rest positions, rigid initial velocity field.
+  m.state.x = problem.mesh.vertices;
+  m.state.v.resize(n, 3);
+  for (int v = 0; v < n; ++v) {
+    const Eigen::Vector3d x = problem.mesh.vertices.row(v);
+    m.state.v.row(v) = (problem.initial.velocity + problem.initial.angular_velocity.cross(x - problem.initial.center)).transpose();
+  }
+  m.limit_rest = m.model.limit_points(m.model.extended().rest);
+  m.elements.evaluate(m.consistent(flat(m.state.x)));
+}
+
+Simulator::~Simulator() = default;
+
+const DynamicState& Simulator::state() const { return impl_->state; }
+int Simulator::num_vertices() const { return impl_->n; }
+int Simulator::num_steps() const {
+  return static_cast<int>(std::ceil(impl_->problem.time.end / impl_->problem.time.dt - 1e-9));
+}
+const Eigen::MatrixX3d& Simulator::limit_rest() const { return impl_->limit_rest; }
+double Simulator::kinetic_energy() const {
+  const Eigen::VectorXd v = flat(impl_->state.v);
+  return 0.5 * v.dot(impl_->mass.cwiseProduct(v));
+}
+double Simulator::elastic_energy() const { return impl_->elements.energy(); }
+double Simulator::external_work() const { return impl_->work; }
+const Eigen::VectorXd& Simulator::vertex_mass() const { return impl_->mass_per_vertex; }
+
+Eigen::MatrixX3d Simulator::limit_positions() const {
+  const Impl& m = *impl_;
+  const Eigen::MatrixX3d u = unflat(m.consistent(flat(m.state.x)));
+  return m.model.limit_points(m.model.extended().rest + m.model.dofs().expand(u));
+}
+
+StepStats Simulator::step() {
+  Impl& m = *impl_;
+  const DynamicProblem& p = m.problem;
+  const double h = p.time.dt;
+  const int step_number = m.state.step + 1;
+  const double t_next = (m.state.step + 1) * h;
+  StepStats stats;
+  stats.step = step_number;
+  stats.t = t_next;
+
+  const Eigen::VectorXd x = flat(m.state.x), v = flat(m.state.v);
+  // Prescribed velocities put scripted components exactly on their motion at t + h.
+  Eigen::VectorXd target = x;
+  for (size_t i = 0; i < m.prescribed_dof.size(); ++i) {
+    const int dof = m.prescribed_dof[i];
+    target(dof) = apply_motions(*m.prescribed_motion[i], m.rest.segment<3>(3 * (dof / 3)), t_next)(dof % 3);
+  }
+  Eigen::VectorXd v_next = v;
+  for (int dof : m.prescribed_dof) v_next(dof) = (target(dof) - x(dof)) / h;
+  for (int dof : m.dependent_dof) v_next(dof) = 0.0;
+
+  const double c_mass = 1.0 + h * p.damping.mass;
+  const double c_stiff = h * p.damping.stiffness + h * h;
+  // Linearise at the predicted end-of-step state x + h v (rotations taken there), so that the
+  // element rotations do not lag one step behind a rotating body.
+  Eigen::VectorXd v_k = v;
+  for (int k = 0; k < p.solver.newton_iterations; ++k) {
+    auto t0 = std::chrono::steady_clock::now();
+    if (k > 0 || v_k.squaredNorm() > 0) {  // re-extract rotations at x + h v_k
+      m.elements.evaluate(m.consistent(x + h * v_k));
+      stats.rotate_ms += m.elements.last_rotate_ms();
+      stats.assemble_ms += m.elements.last_force_ms();
+    }
+    t0 = std::chrono::steady_clock::now();
+    Eigen::SparseMatrix<double> a = m.elements.assemble_stiffness();
+    Eigen::VectorXd b = m.mass.cwiseProduct(v) + h * (m.elements.force() + m.f_ext);
+    if (v_k.squaredNorm() > 0) b += h * h * (a * v_k);
+    a *= c_stiff;
+    for (Eigen::Index i = 0; i < 3 * m.n; ++i) a.coeffRef(i, i) += c_mass * m.mass(i);
+    stats.assemble_ms += ms_since(t0);
+
+    t0 = std::chrono::steady_clock::now();
+    if (p.solver.type == LinearSolverType::pcg) {
+      const PcgResult r = solve_pcg(a, b, m.solve_free, v_next, p.solver.tolerance, p.solver.max_iterations);
+      stats.solver_iterations += r.iterations;
+      stats.residual = r.residual;
+      if (!r.converged) {
+        std::ostringstream s;
+        s << "the conjugate gradient solver did not converge: relative residual " << r.residual << " after "
+          << r.iterations << " iterations (tolerance " << p.solver.tolerance
+          << "); try a smaller time step, more iterations or \"solver\": {\"type\": \"cholmod\"}";
+        throw SimulationError(step_number, t_next, s.str());
+      }
+    } else {
+      // Dirichlet rows: move the prescribed columns to the right-hand side, keep a unit diagonal.
+      Eigen::VectorXd fixed_values = Eigen::VectorXd::Zero(3 * m.n);
+      for (Eigen::Index i = 0; i < 3 * m.n; ++i)
+        if (!m.solve_free[i]) fixed_values(i) = v_next(i);
+      b -= a * fixed_values;
+      for (Eigen::Index col = 0; col < a.outerSize(); ++col)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it)
+          if (!m.solve_free[col] || !m.solve_free[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+      for (Eigen::Index i = 0; i < 3 * m.n; ++i)
+        if (!m.solve_free[i]) b(i) = fixed_values(i);
+      if (!m.direct.refactorize(a))
+        throw SimulationError(step_number, t_next, "the system matrix is not positive definite (CHOLMOD)");
+      v_next = m.direct.solve(b);
+      stats.solver_iterations += 1;
+      stats.residual = (a * v_next - b).norm() / std::max(b.norm(), 1e-300);
+    }
+    stats.solve_ms += ms_since(t0);
+    v_k = v_next;
+  }
+
+  // Advance; scripted components land exactly on their motion, tied ones follow their rule.
+  Eigen::VectorXd x_next = x + h * v_next;
+  for (int dof : m.prescribed_dof) x_next(dof) = target(dof);
+  const Eigen::VectorXd u_next = m.consistent(x_next);
+  x_next = m.rest + u_next;
+  for (int dof : m.dependent_dof) v_next(dof) = (x_next(dof) - x(dof)) / h;
+  if (!x_next.allFinite() || !v_next.allFinite())
+    throw SimulationError(step_number, t_next, "the state became NaN or infinite (numerical instability)");
+  if ((x_next - m.rest).cwiseAbs().maxCoeff() > 1e3 * m.bbox)
+    throw SimulationError(step_number, t_next, "the simulation diverged (a vertex moved more than 1000 times the mesh size)");
+
+  // Forces and energy at the new state (reused by the next step's linearisation).
+  m.elements.evaluate(u_next);
+  stats.rotate_ms += m.elements.last_rotate_ms();
+  stats.assemble_ms += m.elements.last_force_ms();
+
+  for (Eigen::Index i = 0; i < 3 * m.n; ++i)
+    if (m.solve_free[i]) m.work += m.f_ext(i) * (x_next(i) - x(i));
+  m.state.x = unflat(x_next);
+  m.state.v = unflat(v_next);
+  m.state.t = t_next;
+  m.state.step = step_number;
+  stats.kinetic_energy = kinetic_energy();
+  stats.elastic_energy = elastic_energy();
+  return stats;
+}
+
+}  // namespace clothsim

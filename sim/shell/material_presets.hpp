@@ -1,0 +1,20 @@
+// Named shell materials for scene files ("material": {"preset": "cotton"}): the paper's cotton
+// and metal-like material, Kawabata-measured fabrics and the cloths measured by Wang et al. 2011
+// (numbers and sources in material_presets.cpp and /work/shared/reference/fabrics.md).
+#pragma once
+
+#include "sim/shell/material.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+// The preset called `name` (exact, case-sensitive), or std::nullopt if there is none.
+std::optional<ShellMaterial> material_preset(const std::string& name);
+
+// Every preset name, in a fixed order (paper materials, Kawabata fabrics, Wang et al. cloths).
+std::vector<std::string> material_preset_names();
+
+}  // namespace clothsim

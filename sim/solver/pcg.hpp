@@ -1,0 +1,26 @@
+// Preconditioned conjugate gradients for the implicit-Euler system (paper §4.2: "solved using
+// the conjugate gradient method"), with constrained entries filtered out: they keep the values
+// given in x (prescribed velocities) and the iteration runs on the free entries only.
+// Preconditioner: the inverse of each vertex's 3 × 3 diagonal block (block Jacobi).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <vector>
+
+namespace clothsim {
+
+struct PcgResult {
+  int iterations = 0;
+  double residual = 0.0;  // ‖b − A x‖ / ‖b‖ over the free entries (‖b‖ → 1 when b = 0)
+  bool converged = false;
+};
+
+// Solves A x = b on the entries with free[i] != 0 (A symmetric positive definite there, stored
+// in full, 3 × 3 vertex blocks); x holds the warm start and, at constrained entries, their fixed
+// values, which enter the right-hand side.
+PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const std::vector<char>& free,
+                    Eigen::VectorXd& x, double tolerance, int max_iterations);
+
+}  // namespace clothsim
