@@ -53,6 +53,8 @@ struct DynamicProblem {
   Eigen::Vector3d surface_load = Eigen::Vector3d::Zero();  // [N/m² of reference area]
   double pressure = 0.0;                                   // [N/m²] along the reference normal
   std::vector<PointLoad> point_loads;                      // [N], constant
+  std::vector<MomentLoad> moments;                         // [N·m], follower couples
+  double ramp_time = 0.0;  // [s] external loads grow linearly from 0 to full over this time
   Quadrature quadrature = Quadrature::one_point;
   TimeSettings time;
   DampingSettings damping;

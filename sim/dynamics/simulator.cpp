@@ -38,6 +38,12 @@ void check_problem(const DynamicProblem& p) {
   if (!(std::isfinite(p.time.dt) && p.time.dt > 0)) throw std::runtime_error("time.dt must be > 0 [s]");
   if (!(std::isfinite(p.time.end) && p.time.end > 0)) throw std::runtime_error("time.end must be > 0 [s]");
   if (!(p.damping.stiffness >= 0 && p.damping.mass >= 0)) throw std::runtime_error("damping must be >= 0");
+  if (!(p.ramp_time >= 0)) throw std::runtime_error("loads.ramp_time must be >= 0 [s]");
+  for (size_t i = 0; i < p.moments.size(); ++i) {
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * p.mesh.num_vertices());
+    if (!add_moment_forces(p.moments[i], p.mesh.vertices, f))
+      throw std::runtime_error("moment " + std::to_string(i) + ": its vertices lie on a line parallel to the moment");
+  }
   if (!(p.solver.tolerance > 0 && p.solver.tolerance < 1)) throw std::runtime_error("solver.tolerance must lie in (0, 1)");
   if (p.solver.max_iterations < 1 || p.solver.newton_iterations < 1)
     throw std::runtime_error("solver.max_iterations and solver.newton_iterations must be >= 1");
@@ -59,7 +65,7 @@ struct Simulator::Impl {
   Eigen::VectorXd rest;     // 3n rest positions
   Eigen::VectorXd mass;     // 3n lumped mass per DOF [kg]
   Eigen::VectorXd mass_per_vertex;
-  Eigen::VectorXd f_ext;    // 3n constant external force [N]
+  Eigen::VectorXd f_ext;    // 3n constant external force [N] (before the ramp; no couples)
   CorotationalElements elements;
   std::vector<char> solve_free;            // 3n: unknown in the linear solve
   std::vector<int> prescribed_dof;         // fixed components: DOF ids
@@ -202,8 +208,21 @@ StepStats Simulator::step() {
   // Linearise at the predicted end-of-step state x + h v (rotations taken there), so that the
   // element rotations do not lag one step behind a rotating body.
   Eigen::VectorXd v_k = v;
+  // External loads at this step: ramped; the follower couples act on the linearisation point
+  // (re-evaluated with each Newton iteration).
+  const double ramp = p.ramp_time > 0 ? std::min(1.0, t_next / p.ramp_time) : 1.0;
+  Eigen::VectorXd f_ext;
+  auto external_force = [&](const Eigen::VectorXd& at) {
+    f_ext = m.f_ext;
+    for (size_t i = 0; i < p.moments.size(); ++i)
+      if (!add_moment_forces(p.moments[i], unflat(at), f_ext))
+        throw SimulationError(step_number, t_next,
+                              "moment " + std::to_string(i) + ": its vertices have come to lie on a line parallel to the moment");
+    f_ext *= ramp;
+  };
   for (int k = 0; k < p.solver.newton_iterations; ++k) {
     auto t0 = std::chrono::steady_clock::now();
+    external_force(x + h * v_k);
     if (k > 0 || v_k.squaredNorm() > 0) {  // re-extract rotations at x + h v_k
       m.elements.evaluate(m.consistent(x + h * v_k));
       stats.rotate_ms += m.elements.last_rotate_ms();
@@ -211,7 +230,7 @@ StepStats Simulator::step() {
     }
     t0 = std::chrono::steady_clock::now();
     Eigen::SparseMatrix<double> a = m.elements.assemble_stiffness();
-    Eigen::VectorXd b = m.mass.cwiseProduct(v) + h * (m.elements.force() + m.f_ext);
+    Eigen::VectorXd b = m.mass.cwiseProduct(v) + h * (m.elements.force() + f_ext);
     if (v_k.squaredNorm() > 0) b += h * h * (a * v_k);
     a *= c_stiff;
     for (Eigen::Index i = 0; i < 3 * m.n; ++i) a.coeffRef(i, i) += c_mass * m.mass(i);
@@ -267,7 +286,7 @@ StepStats Simulator::step() {
   stats.assemble_ms += m.elements.last_force_ms();
 
   for (Eigen::Index i = 0; i < 3 * m.n; ++i)
-    if (m.solve_free[i]) m.work += m.f_ext(i) * (x_next(i) - x(i));
+    if (m.solve_free[i]) m.work += f_ext(i) * (x_next(i) - x(i));
   m.state.x = unflat(x_next);
   m.state.v = unflat(v_next);
   m.state.t = t_next;

@@ -450,6 +450,29 @@ Motion read_motion(const Reader& r, const Json& item, const std::string& path) {
   return m;
 }
 
+// `select`: {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} → the control vertices in the
+// closed box (at least one).
+std::vector<int> read_selection(const Reader& r, const Json& item, const std::string& path, const TriMesh& mesh) {
+  const std::string select_path = join_key(path, "select");
+  const Json& select = r.require(item, path, "select");
+  r.check_object(select, select_path, {"box"});
+  const std::string box_path = join_key(select_path, "box");
+  const Json& box = r.require(select, select_path, "box");
+  if (!box.is_array() || box.size() != 2)
+    r.fail(box_path, "expected an array of 2 points [[xmin, ymin, zmin], [xmax, ymax, zmax]] (got " +
+                         describe(box) + ")");
+  const Eigen::Vector3d lo = r.vec3(box[0], join_index(box_path, 0));
+  const Eigen::Vector3d hi = r.vec3(box[1], join_index(box_path, 1));
+  for (int k = 0; k < 3; ++k)
+    if (lo[k] > hi[k])
+      r.fail(box_path, std::string("min must be <= max in every component (got ") + kAxes[k] + "min = " +
+                           format_number(lo[k]) + " > " + kAxes[k] + "max = " + format_number(hi[k]) + ")");
+  std::vector<int> vertices = select_box(mesh.vertices, lo, hi);
+  if (vertices.empty())
+    r.fail(box_path, "selects no vertex of the mesh (mesh bounding box: " + bounding_box(mesh.vertices) + ")");
+  return vertices;
+}
+
 std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, const TriMesh& mesh, bool dynamic,
                                              const LogFn& log) {
   std::vector<BoundaryCondition> out;
@@ -460,21 +483,7 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
     const Json& item = (*j)[i];
     r.check_object(item, path, {"select", "fix", "rotation", "motion"});
     BoundaryCondition bc;
-
-    const std::string select_path = join_key(path, "select");
-    const Json& select = r.require(item, path, "select");
-    r.check_object(select, select_path, {"box"});
-    const std::string box_path = join_key(select_path, "box");
-    const Json& box = r.require(select, select_path, "box");
-    if (!box.is_array() || box.size() != 2)
-      r.fail(box_path, "expected an array of 2 points [[xmin, ymin, zmin], [xmax, ymax, zmax]] (got " +
-                           describe(box) + ")");
-    const Eigen::Vector3d lo = r.vec3(box[0], join_index(box_path, 0));
-    const Eigen::Vector3d hi = r.vec3(box[1], join_index(box_path, 1));
-    for (int k = 0; k < 3; ++k)
-      if (lo[k] > hi[k])
-        r.fail(box_path, std::string("min must be <= max in every component (got ") + kAxes[k] + "min = " +
-                             format_number(lo[k]) + " > " + kAxes[k] + "max = " + format_number(hi[k]) + ")");
+    bc.vertices = read_selection(r, item, path, mesh);
 
     if (const Json* fix = r.find(item, "fix")) {
       const std::string fix_path = join_key(path, "fix");
@@ -502,9 +511,6 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
         r.fail(motion_path, "has no effect: the motion drives the fixed components and \"fix\" is empty");
     }
 
-    bc.vertices = select_box(mesh.vertices, lo, hi);
-    if (bc.vertices.empty())
-      r.fail(box_path, "selects no vertex of the mesh (mesh bounding box: " + bounding_box(mesh.vertices) + ")");
     log(path + ": " + std::to_string(bc.vertices.size()) + " vertices");
     out.push_back(std::move(bc));
   }
@@ -518,9 +524,30 @@ std::string describe_snap(const Eigen::MatrixX3d& vertices, int v, const Eigen::
          " m from the requested point)";
 }
 
-void read_loads(const Reader& r, const Json* j, StaticProblem& problem, const LogFn& log) {
+void read_loads(const Reader& r, const Json* j, StaticProblem& problem, double* ramp_time, const LogFn& log) {
   if (j == nullptr) return;
-  r.check_object(*j, "loads", {"gravity", "surface_load", "pressure", "point_loads"});
+  r.check_object(*j, "loads", {"gravity", "surface_load", "pressure", "point_loads", "moments", "ramp_time"});
+  if (const Json* ramp = r.find(*j, "ramp_time")) {
+    if (ramp_time == nullptr) r.fail("loads.ramp_time", "needs \"analysis\": \"dynamic\" (this scene is static)");
+    *ramp_time = r.non_negative(*ramp, "loads.ramp_time", "[s]");
+  }
+  if (const Json* moments = r.find(*j, "moments")) {
+    r.array(*moments, "loads.moments");
+    for (std::size_t i = 0; i < moments->size(); ++i) {
+      const std::string path = join_index("loads.moments", i);
+      const Json& item = (*moments)[i];
+      r.check_object(item, path, {"select", "moment"});
+      MomentLoad load;
+      load.vertices = read_selection(r, item, path, problem.mesh);
+      load.moment = r.vec3(r.require(item, path, "moment"), join_key(path, "moment"));
+      Eigen::VectorXd probe = Eigen::VectorXd::Zero(3 * problem.mesh.num_vertices());
+      if (!add_moment_forces(load, problem.mesh.vertices, probe))
+        r.fail(join_key(path, "select"), "the selected vertices lie on one line parallel to the moment; select at "
+                                         "least two rows of vertices across it");
+      log(path + ": " + std::to_string(load.vertices.size()) + " vertices");
+      problem.moments.push_back(std::move(load));
+    }
+  }
   if (const Json* g = r.find(*j, "gravity")) problem.gravity = r.vec3(*g, "loads.gravity");
   if (const Json* s = r.find(*j, "surface_load")) problem.surface_load = r.vec3(*s, "loads.surface_load");
   if (const Json* s = r.find(*j, "pressure")) problem.pressure = r.number(*s, "loads.pressure");
@@ -699,7 +726,7 @@ Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
   }
 
   scene.problem.boundary = read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, dynamic, say);
-  read_loads(r, r.find(root, "loads"), scene.problem, say);
+  read_loads(r, r.find(root, "loads"), scene.problem, dynamic ? &dyn.ramp_time : nullptr, say);
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
 
   if (dynamic) {
@@ -711,6 +738,7 @@ Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
     dyn.surface_load = p.surface_load;
     dyn.pressure = p.pressure;
     dyn.point_loads = p.point_loads;
+    dyn.moments = p.moments;
     dyn.quadrature = p.quadrature;
   }
   return scene;

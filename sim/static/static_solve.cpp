@@ -59,6 +59,9 @@ StaticResult solve_static(const StaticProblem& problem) {
   Eigen::VectorXd f = model.area_load(problem.surface_load + problem.material.areal_density * problem.gravity);
   if (problem.pressure != 0.0) f += model.pressure_load(problem.pressure);
   for (const PointLoad& p : problem.point_loads) f += model.point_load(p.vertex, p.force);
+  for (size_t i = 0; i < problem.moments.size(); ++i)
+    if (!add_moment_forces(problem.moments[i], problem.mesh.vertices, f))
+      throw std::runtime_error("moment " + std::to_string(i) + ": its vertices lie on a line parallel to the moment");
   model.restrict_to_free(f);
   StaticResult result;
   result.assemble_seconds = seconds_since(t0);

@@ -5,6 +5,7 @@
 #include "sim/mesh/mesh.hpp"
 #include "sim/shell/boundary_condition.hpp"
 #include "sim/shell/material.hpp"
+#include "sim/shell/moment_load.hpp"
 #include "sim/shell/quadrature.hpp"
 
 #include <Eigen/Core>
@@ -30,6 +31,7 @@ struct StaticProblem {
   Eigen::Vector3d surface_load = Eigen::Vector3d::Zero();  // [N/m² of reference area]
   double pressure = 0.0;  // [N/m²] along the reference surface normal (the triangles' orientation)
   std::vector<PointLoad> point_loads;
+  std::vector<MomentLoad> moments;  // couples on vertex groups (at the rest positions)
   Quadrature quadrature = Quadrature::one_point;
 };
 

@@ -183,7 +183,7 @@ TEST_F(SceneLoader, NearestVertexTiesGoToLowestIndex) {
 
 TEST_F(SceneLoader, UnknownKeysAtAnyLevel) {
   EXPECT_EQ(error(std::string("{") + kGrid4 + R"(, "loads": {"gravty": [0, 0, -9.81]}})"),
-            expected("loads.gravty: unknown key (allowed: gravity, surface_load, pressure, point_loads)"));
+            expected("loads.gravty: unknown key (allowed: gravity, surface_load, pressure, point_loads, moments, ramp_time)"));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "colour": "red"})"),
                        expected("colour: unknown key (allowed: name, description, analysis, mesh")));
   EXPECT_TRUE(contains(error(R"({"mesh": {"primitive": "grid", "size": [1, 1], "divisions": [4, 4], "radius": 1}})"),
