@@ -128,17 +128,27 @@ Eigen::SparseMatrix<double> CorotationalElements::assemble_stiffness() const {
   for (const std::vector<int>& group : model_.color_groups())
     tbb::parallel_for(tbb::blocked_range<size_t>(0, group.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
       Eigen::MatrixXd rotated;
+      double* values = k.valuePtr();
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const int e = group[i];
         const Eigen::Matrix3d& r = rotation_[e];
         const Eigen::MatrixXd& ke = stiffness_[e];
         const Eigen::Index nb = ke.rows() / 3;
-        rotated.resize(ke.rows(), ke.cols());
-        // R K_e Rᵀ block by block.
-        for (Eigen::Index a = 0; a < nb; ++a)
-          for (Eigen::Index b = 0; b < nb; ++b)
-            rotated.block<3, 3>(3 * a, 3 * b).noalias() = r * ke.block<3, 3>(3 * a, 3 * b) * r.transpose();
-        model_.add_patch_matrix(e, rotated, k);
+        const bool direct = model_.elements()[e].identity;
+        if (!direct) rotated.resize(ke.rows(), ke.cols());
+        // R K_e Rᵀ block by block, using the symmetry of K_e.
+        for (Eigen::Index b = 0; b < nb; ++b)
+          for (Eigen::Index a = 0; a <= b; ++a) {
+            const Eigen::Matrix3d block = r * ke.block<3, 3>(3 * a, 3 * b) * r.transpose();
+            if (direct) {
+              model_.add_block(e, static_cast<size_t>(a), static_cast<size_t>(b), block, values);
+              if (a != b) model_.add_block(e, static_cast<size_t>(b), static_cast<size_t>(a), block.transpose(), values);
+            } else {
+              rotated.block<3, 3>(3 * a, 3 * b) = block;
+              rotated.block<3, 3>(3 * b, 3 * a) = block.transpose();
+            }
+          }
+        if (!direct) model_.add_patch_matrix(e, rotated, k);
       }
     });
   return k;

@@ -75,6 +75,15 @@ class ShellModel {
   // folds a patch-coordinate matrix into the values of a matrix with the stiffness pattern
   // (elements of one colour group may do this concurrently);
   void add_patch_matrix(int e, const Eigen::MatrixXd& k_patch, Eigen::SparseMatrix<double>& global) const;
+  // adds a 3 × 3 block for the pair (a, b) of element e's real vertices (indices into
+  // ShellElement::real, which equal patch indices for identity elements) to matrix values;
+  void add_block(int e, size_t a, size_t b, const Eigen::Matrix3d& block, double* values) const {
+    const size_t m = elements_[e].real.size();
+    double* target = values + slots_[e][a + m * b];
+    const int stride = block_stride_[elements_[e].real[b]];
+    for (int d = 0; d < 3; ++d)
+      for (int c = 0; c < 3; ++c) target[d * stride + c] += block(c, d);
+  }
   // folds a patch-coordinate vector into a global vector.
   void add_patch_vector(int e, const Eigen::VectorXd& f_patch, Eigen::VectorXd& global) const {
     scatter_vector(elements_[e], f_patch, global);

@@ -1,10 +1,32 @@
 #include "sim/solver/pcg.hpp"
 
 #include <Eigen/Cholesky>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <cmath>
 
 namespace clothsim {
+
+namespace {
+
+// y = A x for symmetric A in compressed-column storage: y_j = (column j) · x, so the columns can
+// be shared among threads without write conflicts. Rows of constrained entries give zero.
+void symmetric_product(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& x, const Eigen::VectorXd& mask,
+                       Eigen::VectorXd& y) {
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* values = a.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, a.outerSize(), 512), [&](const tbb::blocked_range<Eigen::Index>& r) {
+    for (Eigen::Index j = r.begin(); j != r.end(); ++j) {
+      double sum = 0.0;
+      for (int k = outer[j]; k < outer[j + 1]; ++k) sum += values[k] * x[inner[k]];
+      y[j] = sum * mask[j];
+    }
+  });
+}
+
+}  // namespace
 
 PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const std::vector<char>& free,
                     Eigen::VectorXd& x, double tolerance, int max_iterations) {
@@ -43,8 +65,7 @@ PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd&
   p = z;
   double rz = r.dot(z);
   for (int k = 1; k <= max_iterations; ++k) {
-    q.noalias() = a * p;
-    q = q.cwiseProduct(mask);
+    symmetric_product(a, p, mask, q);
     const double pq = p.dot(q);
     if (!(pq > 0.0) || !std::isfinite(pq)) {  // not positive definite on the free entries
       result.iterations = k;
