@@ -47,10 +47,14 @@ void check_problem(const DynamicProblem& p) {
   if (!(p.solver.tolerance > 0 && p.solver.tolerance < 1)) throw std::runtime_error("solver.tolerance must lie in (0, 1)");
   if (p.solver.max_iterations < 1 || p.solver.newton_iterations < 1)
     throw std::runtime_error("solver.max_iterations and solver.newton_iterations must be >= 1");
-  for (size_t i = 0; i < p.boundary.size(); ++i)
+  for (size_t i = 0; i < p.boundary.size(); ++i) {
+    if (p.boundary[i].clamped && !p.boundary[i].motion.empty())
+      throw std::runtime_error("boundary[" + std::to_string(i) +
+                               "]: a clamped border cannot follow a motion yet; use a hinged one");
     for (size_t k = 0; k < p.boundary[i].motion.size(); ++k)
       if (const std::string bad = validate(p.boundary[i].motion[k]); !bad.empty())
         throw std::runtime_error("boundary[" + std::to_string(i) + "].motion[" + std::to_string(k) + "]: " + bad);
+  }
   const int n = p.mesh.num_vertices();
   for (const PointLoad& l : p.point_loads)
     if (l.vertex < 0 || l.vertex >= n) throw std::runtime_error("point load at vertex " + std::to_string(l.vertex) + ": no such vertex");

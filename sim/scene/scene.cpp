@@ -509,6 +509,9 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
         bc.motion.push_back(read_motion(r, (*motion)[m], join_index(motion_path, m)));
       if (!bc.motion.empty() && !bc.fix[0] && !bc.fix[1] && !bc.fix[2])
         r.fail(motion_path, "has no effect: the motion drives the fixed components and \"fix\" is empty");
+      if (!bc.motion.empty() && bc.clamped)
+        r.fail(join_key(path, "rotation"), "\"clamped\" cannot be combined with a motion yet (the clamped border "
+                                           "rule is linear in the displacement); use \"free\" (hinged)");
     }
 
     log(path + ": " + std::to_string(bc.vertices.size()) + " vertices");
