@@ -30,12 +30,18 @@ struct DampingSettings {
 };
 
 enum class LinearSolverType { pcg, cholmod };
+enum class PreconditionerType {
+  block_jacobi,  // inverse 3 × 3 diagonal blocks
+  cholesky,      // a CHOLMOD factor of an earlier step's matrix, refreshed when PCG slows down
+};
 
 struct SolverSettings {
   LinearSolverType type = LinearSolverType::pcg;
   double tolerance = 1e-8;    // relative residual of the linear system (pcg)
   int max_iterations = 2000;  // pcg
   int newton_iterations = 1;  // linear solves per step; > 1 re-extracts rotations (accuracy studies)
+  PreconditionerType preconditioner = PreconditionerType::block_jacobi;  // pcg
+  int refresh_iterations = 20;  // cholesky preconditioner: refactor after a solve that needed more
 };
 
 // Rigid initial velocity field v = velocity + angular_velocity × (X − center).

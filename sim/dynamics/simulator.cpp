@@ -76,6 +76,7 @@ struct Simulator::Impl {
   std::vector<const std::vector<Motion>*> prescribed_motion;  // their motion chain (may be empty)
   std::vector<int> dependent_dof;          // tied components (clamped borders)
   DirectSolver direct;
+  bool have_factor = false;  // `direct` holds a factor usable as PCG preconditioner
   DynamicState state;
   Eigen::MatrixX3d limit_rest;
   double work = 0.0;
@@ -86,7 +87,7 @@ struct Simulator::Impl {
         model(p.mesh, p.material, p.boundary, p.quadrature),
         n(p.mesh.num_vertices()),
         elements(model, p.corotational),
-        direct(/*supernodal=*/3 * p.mesh.num_vertices() > 30000) {}
+        direct(/*supernodal=*/3 * p.mesh.num_vertices() > 3000) {}
 
   // Real displacement vector with the tied components derived from the others.
   Eigen::VectorXd consistent(const Eigen::VectorXd& x) const {
@@ -209,9 +210,9 @@ StepStats Simulator::step() {
 
   const double c_mass = 1.0 + h * p.damping.mass;
   const double c_stiff = h * p.damping.stiffness + h * h;
-  // Linearise at the predicted end-of-step state x + h v (rotations taken there), so that the
-  // element rotations do not lag one step behind a rotating body.
-  Eigen::VectorXd v_k = v;
+  // The first solve is linearised at the current state x (rotations and forces from the end of
+  // the previous step); further Newton iterations at x + h v_k.
+  Eigen::VectorXd v_k = Eigen::VectorXd::Zero(3 * m.n);
   // External loads at this step: ramped; the follower couples act on the linearisation point
   // (re-evaluated with each Newton iteration).
   const double ramp = p.ramp_time > 0 ? std::min(1.0, t_next / p.ramp_time) : 1.0;
@@ -227,7 +228,7 @@ StepStats Simulator::step() {
   for (int k = 0; k < p.solver.newton_iterations; ++k) {
     auto t0 = std::chrono::steady_clock::now();
     external_force(x + h * v_k);
-    if (k > 0 || v_k.squaredNorm() > 0) {  // re-extract rotations at x + h v_k
+    if (k > 0) {  // re-extract rotations at x + h v_k
       m.elements.evaluate(m.consistent(x + h * v_k));
       stats.rotate_ms += m.elements.last_rotate_ms();
       stats.assemble_ms += m.elements.last_force_ms();
@@ -235,14 +236,47 @@ StepStats Simulator::step() {
     t0 = std::chrono::steady_clock::now();
     Eigen::SparseMatrix<double> a = m.elements.assemble_stiffness();
     Eigen::VectorXd b = m.mass.cwiseProduct(v) + h * (m.elements.force() + f_ext);
-    if (v_k.squaredNorm() > 0) b += h * h * (a * v_k);
+    if (k > 0) b += h * h * (a * v_k);
     a *= c_stiff;
     for (Eigen::Index i = 0; i < 3 * m.n; ++i) a.coeffRef(i, i) += c_mass * m.mass(i);
     stats.assemble_ms += ms_since(t0);
 
     t0 = std::chrono::steady_clock::now();
+    // Dirichlet form of the system for CHOLMOD: prescribed columns moved to the right-hand side,
+    // unit diagonal in their rows and columns.
+    auto dirichlet = [&](Eigen::SparseMatrix<double>& matrix, Eigen::VectorXd* rhs) {
+      if (rhs) {
+        Eigen::VectorXd fixed_values = Eigen::VectorXd::Zero(3 * m.n);
+        for (Eigen::Index i = 0; i < 3 * m.n; ++i)
+          if (!m.solve_free[i]) fixed_values(i) = v_next(i);
+        *rhs -= matrix * fixed_values;
+        for (Eigen::Index i = 0; i < 3 * m.n; ++i)
+          if (!m.solve_free[i]) (*rhs)(i) = fixed_values(i);
+      }
+      for (Eigen::Index col = 0; col < matrix.outerSize(); ++col)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(matrix, col); it; ++it)
+          if (!m.solve_free[col] || !m.solve_free[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+    };
+    auto refactor = [&] {
+      Eigen::SparseMatrix<double> copy = a;
+      dirichlet(copy, nullptr);
+      m.have_factor = m.direct.refactorize(copy);
+    };
     if (p.solver.type == LinearSolverType::pcg) {
-      const PcgResult r = solve_pcg(a, b, m.solve_free, v_next, p.solver.tolerance, p.solver.max_iterations);
+      const bool cholesky = p.solver.preconditioner == PreconditionerType::cholesky;
+      if (cholesky && !m.have_factor) refactor();
+      const Preconditioner factor = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { z = m.direct.solve(r); };
+      const Eigen::VectorXd start = v_next;
+      PcgResult r = solve_pcg(a, b, m.solve_free, v_next, p.solver.tolerance, p.solver.max_iterations,
+                              cholesky && m.have_factor ? factor : Preconditioner());
+      if (cholesky && (!r.converged || r.iterations > p.solver.refresh_iterations)) {
+        refactor();  // the matrix has drifted from the factor: refresh it
+        if (!r.converged && m.have_factor) {
+          stats.solver_iterations += r.iterations;
+          v_next = start;
+          r = solve_pcg(a, b, m.solve_free, v_next, p.solver.tolerance, p.solver.max_iterations, factor);
+        }
+      }
       stats.solver_iterations += r.iterations;
       stats.residual = r.residual;
       if (!r.converged) {
@@ -253,16 +287,7 @@ StepStats Simulator::step() {
         throw SimulationError(step_number, t_next, s.str());
       }
     } else {
-      // Dirichlet rows: move the prescribed columns to the right-hand side, keep a unit diagonal.
-      Eigen::VectorXd fixed_values = Eigen::VectorXd::Zero(3 * m.n);
-      for (Eigen::Index i = 0; i < 3 * m.n; ++i)
-        if (!m.solve_free[i]) fixed_values(i) = v_next(i);
-      b -= a * fixed_values;
-      for (Eigen::Index col = 0; col < a.outerSize(); ++col)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it)
-          if (!m.solve_free[col] || !m.solve_free[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
-      for (Eigen::Index i = 0; i < 3 * m.n; ++i)
-        if (!m.solve_free[i]) b(i) = fixed_values(i);
+      dirichlet(a, &b);
       if (!m.direct.refactorize(a))
         throw SimulationError(step_number, t_next, "the system matrix is not positive definite (CHOLMOD)");
       v_next = m.direct.solve(b);

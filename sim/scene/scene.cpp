@@ -594,7 +594,8 @@ DampingSettings read_damping(const Reader& r, const Json* j) {
 SolverSettings read_solver(const Reader& r, const Json* j) {
   SolverSettings s;
   if (j == nullptr) return s;
-  r.check_object(*j, "solver", {"type", "tolerance", "max_iterations", "newton_iterations"});
+  r.check_object(*j, "solver",
+                 {"type", "tolerance", "max_iterations", "newton_iterations", "preconditioner", "refresh_iterations"});
   if (const Json* v = r.find(*j, "type"))
     s.type = r.choice(*v, "solver.type", {"pcg", "cholmod"}, "solver type") == "cholmod" ? LinearSolverType::cholmod
                                                                                       : LinearSolverType::pcg;
@@ -606,6 +607,12 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   if (const Json* v = r.find(*j, "max_iterations")) s.max_iterations = r.integer_at_least(*v, "solver.max_iterations", 1);
   if (const Json* v = r.find(*j, "newton_iterations"))
     s.newton_iterations = r.integer_at_least(*v, "solver.newton_iterations", 1);
+  if (const Json* v = r.find(*j, "preconditioner"))
+    s.preconditioner = r.choice(*v, "solver.preconditioner", {"block_jacobi", "cholesky"}, "preconditioner") == "cholesky"
+                           ? PreconditionerType::cholesky
+                           : PreconditionerType::block_jacobi;
+  if (const Json* v = r.find(*j, "refresh_iterations"))
+    s.refresh_iterations = r.integer_at_least(*v, "solver.refresh_iterations", 1);
   return s;
 }
 

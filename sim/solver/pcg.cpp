@@ -29,15 +29,15 @@ void symmetric_product(const Eigen::SparseMatrix<double>& a, const Eigen::Vector
 }  // namespace
 
 PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const std::vector<char>& free,
-                    Eigen::VectorXd& x, double tolerance, int max_iterations) {
+                    Eigen::VectorXd& x, double tolerance, int max_iterations, const Preconditioner& preconditioner) {
   const Eigen::Index n = b.size();
   const Eigen::Index blocks = n / 3;
   Eigen::VectorXd mask(n);
   for (Eigen::Index i = 0; i < n; ++i) mask(i) = free[i] ? 1.0 : 0.0;
 
-  // Block-Jacobi preconditioner on the free entries.
-  std::vector<Eigen::Matrix3d> inverse(blocks);
-  for (Eigen::Index v = 0; v < blocks; ++v) {
+  // Block-Jacobi preconditioner on the free entries (unless one is given).
+  std::vector<Eigen::Matrix3d> inverse(preconditioner ? 0 : blocks);
+  for (Eigen::Index v = 0; v < static_cast<Eigen::Index>(inverse.size()); ++v) {
     Eigen::Matrix3d block = Eigen::Matrix3d::Identity();
     for (int c = 0; c < 3; ++c)
       for (int d = 0; d < 3; ++d)
@@ -48,6 +48,11 @@ PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd&
       if (!free[3 * v + c]) inverse[v].row(c).setZero(), inverse[v].col(c).setZero();
   }
   auto precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+    if (preconditioner) {
+      preconditioner(r, z);
+      z = z.cwiseProduct(mask);
+      return;
+    }
     for (Eigen::Index v = 0; v < blocks; ++v) z.segment<3>(3 * v) = inverse[v] * r.segment<3>(3 * v);
   };
 

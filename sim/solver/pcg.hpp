@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <vector>
 
 namespace clothsim {
@@ -17,10 +18,14 @@ struct PcgResult {
   bool converged = false;
 };
 
+// z = P⁻¹ r for a residual r that is zero at the constrained entries (z must be zero there too).
+using Preconditioner = std::function<void(const Eigen::VectorXd& r, Eigen::VectorXd& z)>;
+
 // Solves A x = b on the entries with free[i] != 0 (A symmetric positive definite there, stored
 // in full, 3 × 3 vertex blocks); x holds the warm start and, at constrained entries, their fixed
-// values, which enter the right-hand side.
+// values, which enter the right-hand side. Without `preconditioner`, block Jacobi.
 PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const std::vector<char>& free,
-                    Eigen::VectorXd& x, double tolerance, int max_iterations);
+                    Eigen::VectorXd& x, double tolerance, int max_iterations,
+                    const Preconditioner& preconditioner = nullptr);
 
 }  // namespace clothsim

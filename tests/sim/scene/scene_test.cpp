@@ -580,8 +580,10 @@ TEST_F(SceneLoader, DynamicSettingErrors) {
             expected("solver.newton_iterations: must be an integer >= 1 (got 0)"));
   EXPECT_TRUE(contains(with(R"("solver": {"max_iterations": 10.5})"), expected("solver.max_iterations: expected an integer")));
   EXPECT_TRUE(contains(with(R"("solver": {"preconditioner": "jacobi"})"),
-                       expected("solver.preconditioner: unknown key (allowed: type, tolerance, max_iterations, "
-                                "newton_iterations)")));
+                       expected("solver.preconditioner: unknown value \"jacobi\"")));
+  EXPECT_TRUE(contains(with(R"("solver": {"precondition": "cholesky"})"),
+                       expected("solver.precondition: unknown key (allowed: type, tolerance, max_iterations, "
+                                "newton_iterations, preconditioner, refresh_iterations)")));
   EXPECT_EQ(with(R"("corotational": "yes")"), expected("corotational: expected true or false (got \"yes\")"));
   EXPECT_EQ(with(R"("corotational": 1)"), expected("corotational: expected true or false (got 1)"));
   EXPECT_TRUE(contains(with(R"("initial": {"velocity": [0, 0]})"), expected("initial.velocity: expected an array of 3 numbers")));
