@@ -1,5 +1,7 @@
 #include "sim/dynamics/corotation.hpp"
 
+#include "sim/shell/element.hpp"
+#include "sim/subdivision/box_spline.hpp"
 #include "sim/subdivision/patch.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -64,6 +66,10 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
   rest_a1_.resize(count);
   rest_a2_.resize(count);
   rotation_.assign(count, Eigen::Matrix3d::Identity());
+  membrane_.resize(count);
+  membrane_material_.resize(count);
+  area_weight_.resize(count);
+  geometric_stiffness_.resize(count);
   local_force_.resize(count);
   local_energy_.assign(count, 0.0);
   const Eigen::MatrixX3d& rest = model.extended().rest;
@@ -81,6 +87,15 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
       for (Eigen::Index p = 0; p < np; ++p) x.row(p) = rest.row(el.patch[p]);
       rest_a1_[e] = (tangent_rows_[e].row(0) * x).transpose();
       rest_a2_[e] = (tangent_rows_[e].row(1) * x).transpose();
+      for (size_t q = 0; q < el.basis.size(); ++q) {
+        const SurfacePoint s = surface_point(el.basis[q], x);
+        StrainMatrix m, b;
+        strain_matrices(el.basis[q], s, m, b);
+        membrane_[e].push_back(m);
+        membrane_material_[e].push_back(model.material().membrane_stiffness() * material_matrix(s, model.material().poisson_ratio));
+        area_weight_[e].push_back(el.weights[q] * s.j);
+      }
+      geometric_stiffness_[e] = Eigen::MatrixXd::Zero(np, np);
     }
   });
   force_ = Eigen::VectorXd::Zero(3 * model.num_vertices());
@@ -112,6 +127,22 @@ void CorotationalElements::evaluate(const Eigen::VectorXd& u) {
       const Eigen::VectorXd kd = stiffness_[e] * d;
       local_energy_[e] = 0.5 * d.dot(kd);
       local_force_[e] = -rotate_blocks(r, kd);
+      if (!geometric_) continue;
+      // Tension stiffening from the membrane force of the corotated strain.
+      const ShellElement& el = model_.elements()[e];
+      Eigen::MatrixXd& g = geometric_stiffness_[e];
+      g.setZero();
+      for (size_t q = 0; q < membrane_[e].size(); ++q) {
+        const Eigen::Vector3d n = membrane_material_[e][q] * (membrane_[e][q] * d);  // n¹¹, n²², n¹²
+        Eigen::Matrix2d stress;
+        stress << n(0), n(2), n(2), n(1);
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(stress);
+        const Eigen::Vector2d tension = eig.eigenvalues().cwiseMax(0.0);
+        if (tension.maxCoeff() <= 0.0) continue;
+        const Eigen::Matrix2d positive = eig.eigenvectors() * tension.asDiagonal() * eig.eigenvectors().transpose();
+        const Eigen::Matrix<double, 2, Eigen::Dynamic> rows = el.basis[q].middleRows(1, 2);  // N,1 and N,2
+        g.noalias() += area_weight_[e][q] * (rows.transpose() * positive * rows);
+      }
     }
   });
   force_.setZero();
@@ -137,9 +168,11 @@ Eigen::SparseMatrix<double> CorotationalElements::assemble_stiffness() const {
         const bool direct = model_.elements()[e].identity;
         if (!direct) rotated.resize(ke.rows(), ke.cols());
         // R K_e Rᵀ block by block, using the symmetry of K_e.
+        const Eigen::MatrixXd& geo = geometric_stiffness_[e];
         for (Eigen::Index b = 0; b < nb; ++b)
           for (Eigen::Index a = 0; a <= b; ++a) {
-            const Eigen::Matrix3d block = r * ke.block<3, 3>(3 * a, 3 * b) * r.transpose();
+            Eigen::Matrix3d block = r * ke.block<3, 3>(3 * a, 3 * b) * r.transpose();
+            if (geometric_) block.diagonal().array() += geo(a, b);
             if (direct) {
               model_.add_block(e, static_cast<size_t>(a), static_cast<size_t>(b), block, values);
               if (a != b) model_.add_block(e, static_cast<size_t>(b), static_cast<size_t>(a), block.transpose(), values);
