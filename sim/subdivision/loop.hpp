@@ -4,6 +4,8 @@
 
 #include "sim/mesh/mesh.hpp"
 
+#include <Eigen/SparseCore>
+
 #include <vector>
 
 namespace clothsim {
@@ -25,5 +27,14 @@ std::vector<double> limit_tangent_mask(int valence, int which /* 0: t1, 1: t2 */
 // New vertex ids: old vertices keep their index, then one vertex per edge. Each triangle
 // (a, b, c) becomes four, in the order: corner a, corner b, corner c, middle.
 TriMesh loop_subdivide(const TriMesh& mesh, double corner_angle_deg = 30.0);
+
+// The same step as a linear operator: new positions = S · old positions (S is #new × #old), with
+// the refined triangles. Corner decisions use `positions` (#V × 3).
+struct SubdivisionStep {
+  Eigen::SparseMatrix<double> matrix;
+  std::vector<Triangle> triangles;
+};
+SubdivisionStep loop_subdivision_step(const Eigen::MatrixX3d& positions, const std::vector<Triangle>& triangles,
+                                      double corner_angle_deg = 30.0);
 
 }  // namespace clothsim
