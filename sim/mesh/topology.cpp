@@ -1,7 +1,7 @@
 #include "sim/mesh/topology.hpp"
 
 #include <algorithm>
-#include <map>
+#include <tuple>
 #include <string>
 
 namespace clothsim {
@@ -15,9 +15,13 @@ std::string tri_name(int t, const Triangle& tri) {
 
 Topology::Topology(int num_vertices, const std::vector<Triangle>& triangles)
     : rings_(num_vertices), boundary_(num_vertices, false), next_(num_vertices) {
-  // Undirected edge use counts and directed edge owners.
-  std::map<std::pair<int, int>, int> directed;  // (a, b) -> triangle
-  std::map<std::pair<int, int>, int> undirected_count;
+  // Directed edges (a, b, triangle), sorted: a repeated directed edge means two triangles
+  // traverse it the same way; more than two uses of an undirected edge is non-manifold.
+  struct Directed {
+    int a, b, t;
+  };
+  std::vector<Directed> directed;
+  directed.reserve(3 * triangles.size());
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
     const Triangle& tri = triangles[t];
     for (int k = 0; k < 3; ++k) {
@@ -26,19 +30,30 @@ Topology::Topology(int num_vertices, const std::vector<Triangle>& triangles)
         throw MeshError(tri_name(t, tri) + ": vertex index out of range (mesh has " +
                         std::to_string(num_vertices) + " vertices)");
       if (a == b || b == c || a == c) throw MeshError(tri_name(t, tri) + " is degenerate: repeated vertex");
-      const int count = ++undirected_count[{std::min(a, b), std::max(a, b)}];
-      if (count > 2)
-        throw MeshError("non-manifold edge (" + std::to_string(std::min(a, b)) + ", " +
-                        std::to_string(std::max(a, b)) + "): shared by more than two triangles, e.g. " +
-                        tri_name(t, tri));
-      auto [it, inserted] = directed.emplace(std::make_pair(a, b), t);
-      if (!inserted)
-        throw MeshError("inconsistent orientation at edge (" + std::to_string(a) + ", " +
-                        std::to_string(b) + "): " + tri_name(it->second, triangles[it->second]) +
-                        " and " + tri_name(t, tri) + " traverse it in the same direction");
+      directed.push_back({a, b, t});
       next_[a].emplace_back(b, c);
     }
   }
+  std::vector<Directed> undirected = directed;
+  for (Directed& d : undirected)
+    if (d.a > d.b) std::swap(d.a, d.b);
+  auto less = [](const Directed& x, const Directed& y) { return std::tie(x.a, x.b, x.t) < std::tie(y.a, y.b, y.t); };
+  std::sort(undirected.begin(), undirected.end(), less);
+  for (size_t i = 0; i + 2 < undirected.size(); ++i)
+    if (undirected[i].a == undirected[i + 2].a && undirected[i].b == undirected[i + 2].b) {
+      const int t = undirected[i + 2].t;
+      throw MeshError("non-manifold edge (" + std::to_string(undirected[i].a) + ", " +
+                      std::to_string(undirected[i].b) + "): shared by more than two triangles, e.g. " +
+                      tri_name(t, triangles[t]));
+    }
+  std::sort(directed.begin(), directed.end(), less);
+  for (size_t i = 0; i + 1 < directed.size(); ++i)
+    if (directed[i].a == directed[i + 1].a && directed[i].b == directed[i + 1].b) {
+      const int t0 = directed[i].t, t1 = directed[i + 1].t;
+      throw MeshError("inconsistent orientation at edge (" + std::to_string(directed[i].a) + ", " +
+                      std::to_string(directed[i].b) + "): " + tri_name(t0, triangles[t0]) + " and " +
+                      tri_name(t1, triangles[t1]) + " traverse it in the same direction");
+    }
   for (int v = 0; v < num_vertices; ++v) {
     auto& pairs = next_[v];
     if (pairs.empty()) throw MeshError("isolated vertex " + std::to_string(v) + ": it belongs to no triangle");

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -34,15 +35,17 @@ SubdivisionStep loop_subdivision_step(const Eigen::MatrixX3d& x, const std::vect
   const int n = static_cast<int>(x.rows());
   const Topology top(n, triangles);
 
-  // Edge ids in order of first appearance.
-  std::map<std::pair<int, int>, int> edge_id;
-  std::vector<std::pair<int, int>> edges;
+  // Edges sorted by (min, max) vertex; an edge's id is its position in that order.
   auto key = [](int a, int b) { return std::make_pair(std::min(a, b), std::max(a, b)); };
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(3 * triangles.size());
   for (const Triangle& t : triangles)
-    for (int k = 0; k < 3; ++k) {
-      auto [it, inserted] = edge_id.emplace(key(t[k], t[(k + 1) % 3]), static_cast<int>(edges.size()));
-      if (inserted) edges.push_back(it->first);
-    }
+    for (int k = 0; k < 3; ++k) edges.push_back(key(t[k], t[(k + 1) % 3]));
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  auto edge_index = [&](int a, int b) {
+    return static_cast<int>(std::lower_bound(edges.begin(), edges.end(), key(a, b)) - edges.begin());
+  };
 
   std::vector<Eigen::Triplet<double>> w;
   const double cos_corner = std::cos(corner_angle_deg * std::numbers::pi / 180.0);
@@ -83,7 +86,7 @@ SubdivisionStep loop_subdivision_step(const Eigen::MatrixX3d& x, const std::vect
   out.triangles.reserve(4 * triangles.size());
   for (const Triangle& t : triangles) {
     const int a = t[0], b = t[1], c = t[2];
-    const int ab = n + edge_id.at(key(a, b)), bc = n + edge_id.at(key(b, c)), ca = n + edge_id.at(key(c, a));
+    const int ab = n + edge_index(a, b), bc = n + edge_index(b, c), ca = n + edge_index(c, a);
     out.triangles.push_back({a, ab, ca});
     out.triangles.push_back({b, bc, ab});
     out.triangles.push_back({c, ca, bc});
