@@ -7,6 +7,7 @@
 #include "sim/mesh/obj_io.hpp"
 #include "sim/shell/material_presets.hpp"
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -682,13 +683,55 @@ std::vector<int> select_box(const Eigen::MatrixX3d& vertices, const Eigen::Vecto
   return out;
 }
 
+RenderSettings read_render(const Reader& r, const Json* j) {
+  RenderSettings s;
+  if (j == nullptr) return s;
+  r.check_object(*j, "render",
+                 {"width", "height", "refine", "color", "back_color", "background", "wireframe", "ground", "camera"});
+  if (const Json* v = r.find(*j, "width")) s.width = r.integer_at_least(*v, "render.width", 16);
+  if (const Json* v = r.find(*j, "height")) s.height = r.integer_at_least(*v, "render.height", 16);
+  if (s.width > 8192 || s.height > 8192) r.fail("render", "images larger than 8192 px are not supported");
+  if (const Json* v = r.find(*j, "refine")) {
+    s.refine = r.integer_at_least(*v, "render.refine", 0);
+    if (s.refine > 4) r.fail("render.refine", "must be an integer from 0 to 4 (got " + v->dump() + ")");
+  }
+  auto colour = [&](const char* key, Eigen::Vector3d& out) {
+    if (const Json* v = r.find(*j, key)) {
+      const std::string path = std::string("render.") + key;
+      out = r.vec3(*v, path);
+      if ((out.array() < 0).any() || (out.array() > 1).any())
+        r.fail(path, "colour components must lie in [0, 1] (got " + v->dump() + ")");
+    }
+  };
+  colour("color", s.color);
+  colour("back_color", s.back_color);
+  colour("background", s.background);
+  if (const Json* v = r.find(*j, "wireframe")) s.wireframe = r.boolean(*v, "render.wireframe");
+  if (const Json* v = r.find(*j, "ground")) s.ground = r.boolean(*v, "render.ground");
+  if (const Json* cam = r.find(*j, "camera")) {
+    r.check_object(*cam, "render.camera", {"eye", "target", "up", "fov_deg"});
+    s.has_camera = true;
+    s.eye = r.vec3(r.require(*cam, "render.camera", "eye"), "render.camera.eye");
+    s.target = r.vec3(r.require(*cam, "render.camera", "target"), "render.camera.target");
+    if (const Json* v = r.find(*cam, "up")) s.up = r.vec3(*v, "render.camera.up");
+    if (const Json* v = r.find(*cam, "fov_deg")) {
+      s.fov_deg = r.number(*v, "render.camera.fov_deg");
+      if (!(s.fov_deg > 1 && s.fov_deg < 170)) r.fail("render.camera.fov_deg", "must lie in (1, 170) degrees (got " + v->dump() + ")");
+    }
+    if ((s.eye - s.target).norm() <= 0) r.fail("render.camera", "eye and target must differ");
+    if (s.up.cross(s.eye - s.target).norm() <= 1e-12 * s.up.norm() * (s.eye - s.target).norm())
+      r.fail("render.camera.up", "must not be parallel to the viewing direction");
+  }
+  return s;
+}
+
 Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
   const LogFn say = log ? log : LogFn([](const std::string&) {});
   const Reader r(file.string());
   const Json root = parse_file(r, file);
   r.check_object(root, "",
                  {"name", "description", "analysis", "mesh", "material", "boundary", "loads", "probes",
-                  "numerics", "time", "damping", "solver", "corotational", "initial", "output"});
+                  "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render"});
 
   Scene scene;
   scene.file = file;
@@ -728,6 +771,7 @@ Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
     scene.write_obj_frames = read_output(r, r.find(root, "output"));
   }
 
+  scene.render = read_render(r, r.find(root, "render"));
   TriMesh mesh = build_mesh(r, r.require(root, "", "mesh"), file.parent_path(), say);
   try {
     scene.problem.mesh = prepare_control_mesh(mesh, say);

@@ -30,6 +30,20 @@ struct Probe {
   int vertex = -1;                               // nearest control vertex of the prepared mesh
 };
 
+// "render": how the application draws the limit surface (plain settings; sim/ does not render).
+struct RenderSettings {
+  int width = 960, height = 720;  // image size [px]
+  int refine = 2;                  // Loop steps before the limit masks (0–4)
+  Eigen::Vector3d color{0.8, 0.1, 0.1};       // front faces, linear RGB in [0, 1]
+  Eigen::Vector3d back_color{0.5, 0.1, 0.1};  // back faces
+  Eigen::Vector3d background{1, 1, 1};
+  bool wireframe = false;  // overlay the control mesh
+  bool ground = false;     // a ground plane below the animation's bounds
+  bool has_camera = false;  // otherwise framed automatically over the whole animation
+  Eigen::Vector3d eye{0, 0, 1}, target{0, 0, 0}, up{0, 1, 0};  // [m]
+  double fov_deg = 35.0;   // vertical field of view [deg]
+};
+
 struct Scene {
   std::string name;             // safe folder name: [A-Za-z0-9_.-]+, not starting with '.'
   std::string description;
@@ -43,6 +57,7 @@ struct Scene {
   // corotational and initial state.
   DynamicProblem dynamic;
   bool write_obj_frames = false;  // dynamic scenes: "output": {"obj": true}
+  RenderSettings render;
   std::vector<Probe> probes;
 };
 

@@ -554,7 +554,7 @@ TEST_F(SceneLoader, DynamicKeysRejectedInStaticScene) {
   // Unknown keys are still unknown, not "dynamic only".
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "timestep": 0.01})"),
                        expected("timestep: unknown key (allowed: name, description, analysis, mesh, material, boundary, "
-                                "loads, probes, numerics, time, damping, solver, corotational, initial, output)")));
+                                "loads, probes, numerics, time, damping, solver, corotational, initial, output, render)")));
 }
 
 TEST_F(SceneLoader, DynamicSettingErrors) {
