@@ -3,6 +3,10 @@
 // what it has written) and finally summary.json (replaced atomically).
 #include "app/dynamic_run.hpp"
 
+#include "app/limit_surface_drawer.hpp"
+#include "render/png_io.hpp"
+#include "render/renderer.hpp"
+
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/obj_io.hpp"
 
@@ -176,8 +180,8 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
 // The streamed outputs of one run.
 class Outputs {
  public:
-  Outputs(const Scene& scene, const fs::path& dir)
-      : scene_(scene), dir_(dir), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
+  Outputs(const Scene& scene, const fs::path& dir, const LimitSurfaceDrawer* drawer)
+      : scene_(scene), dir_(dir), drawer_(drawer), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy");
     probes_.flush();
@@ -188,8 +192,8 @@ class Outputs {
   // Probe rows and due frames for the state reached after `step` steps, at time `t` [s].
   void record_state(const Simulator& sim, int step, double t, RunTotals& totals) {
     const TimeSettings& time = scene_.dynamic.time;
-    const bool frame_due = scene_.write_obj_frames &&
-                           t >= totals.frames / time.output_fps - 1e-9 * time.dt;
+    const bool frames_wanted = scene_.write_obj_frames || drawer_ != nullptr;
+    const bool frame_due = frames_wanted && t >= totals.frames / time.output_fps - 1e-9 * time.dt;
     if (scene_.probes.empty() && !frame_due) return;
     const Eigen::MatrixX3d limit = sim.limit_positions();
     if (!scene_.probes.empty()) {
@@ -205,15 +209,40 @@ class Outputs {
     }
     // Frame k belongs to the first state with t >= k / fps; a step longer than a frame period
     // repeats the frame so that frame k always shows time ≈ k / fps.
-    while (scene_.write_obj_frames && t >= totals.frames / time.output_fps - 1e-9 * time.dt) {
-      char file[32];
-      std::snprintf(file, sizeof(file), "mesh_%04d.obj", totals.frames);
-      const std::string comment = "clothsim: limit surface of scene " + scene_.name + ", frame " +
-                                  std::to_string(totals.frames) + ", step " + std::to_string(step) +
-                                  ", t = " + format_double(t) + " s";
-      write_obj((dir_ / "frames" / file).string(), limit, scene_.dynamic.mesh.triangles, comment);
+    while (frames_wanted && t >= totals.frames / time.output_fps - 1e-9 * time.dt) {
+      if (scene_.write_obj_frames) {
+        char file[32];
+        std::snprintf(file, sizeof(file), "mesh_%04d.obj", totals.frames);
+        const std::string comment = "clothsim: limit surface of scene " + scene_.name + ", frame " +
+                                    std::to_string(totals.frames) + ", step " + std::to_string(step) +
+                                    ", t = " + format_double(t) + " s";
+        write_obj((dir_ / "frames" / file).string(), limit, scene_.dynamic.mesh.triangles, comment);
+      }
+      if (drawer_) {
+        if (snapshots_.size() == static_cast<std::size_t>(totals.frames)) {
+          snapshots_.push_back(drawer_->snapshot(sim.extended_positions()));
+          LimitSurfaceDrawer::extend_bounds(snapshots_.back(), lo_, hi_);
+        } else {
+          snapshots_.push_back(snapshots_.back());  // a repeated frame
+        }
+      }
       ++totals.frames;
     }
+  }
+
+  // Draws every collected frame with one camera framing the whole sequence:
+  // frame_0000.png, frame_0001.png, ... Returns the number of images written.
+  int render_frames(render::Renderer& renderer) const {
+    if (!drawer_ || snapshots_.empty()) return 0;
+    const render::Camera camera = drawer_->camera(lo_, hi_);
+    int written = 0;
+    for (const SurfaceSnapshot& s : snapshots_) {
+      char file[32];
+      std::snprintf(file, sizeof(file), "frame_%04d.png", written);
+      render::write_png((dir_ / file).string(), renderer.render(drawer_->frame(s, camera, lo_[1])));
+      ++written;
+    }
+    return written;
   }
 
   void record_stats(const StepStats& s) {
@@ -230,6 +259,9 @@ class Outputs {
  private:
   const Scene& scene_;
   fs::path dir_;
+  const LimitSurfaceDrawer* drawer_;
+  std::vector<SurfaceSnapshot> snapshots_;
+  render::Vec3f lo_{1e30f, 1e30f, 1e30f}, hi_{-1e30f, -1e30f, -1e30f};
   StreamFile probes_;
   StreamFile stats_;
 };
@@ -259,7 +291,7 @@ void print_summary(const Scene& scene, const Simulator& sim, const RunTotals& to
 
 }  // namespace
 
-int run_dynamic_scene(const Scene& scene, const fs::path& out_root) {
+int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_frames) {
   const std::string file = scene.file.string();
   const Clock::time_point start = Clock::now();
 
@@ -269,6 +301,18 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root) {
     sim = std::make_unique<Simulator>(scene.dynamic);
   } catch (const std::exception& e) {
     throw std::runtime_error(file + ": cannot set up the dynamic analysis: " + e.what());
+  }
+  // The renderer and the refinement operator, also before any file is written.
+  std::unique_ptr<LimitSurfaceDrawer> drawer;
+  std::unique_ptr<render::Renderer> renderer;
+  if (render_frames) {
+    try {
+      drawer = std::make_unique<LimitSurfaceDrawer>(sim->extended_mesh(), scene.render, scene.render.width,
+                                                    scene.render.height);
+      renderer = std::make_unique<render::Renderer>(scene.render.width, scene.render.height);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(file + ": cannot set up rendering: " + e.what() + " (use --no-render to skip images)");
+    }
   }
   const int steps = sim->num_steps();
   const std::vector<std::string> warnings = settings_warnings(scene, steps);
@@ -285,10 +329,11 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root) {
 
   RunTotals totals;
   std::string failure;  // the error message of a failed run
+  std::unique_ptr<Outputs> outputs;
   try {
     write_atomically(dir / "summary.json", summary_json(scene, totals, seconds_since(start), warnings, "running", ""));
-    Outputs outputs(scene, dir);
-    outputs.record_state(*sim, 0, sim->state().t, totals);
+    outputs = std::make_unique<Outputs>(scene, dir, drawer.get());
+    outputs->record_state(*sim, 0, sim->state().t, totals);
     const int progress_every = std::max(1, (steps + 9) / 10);
     for (int k = 1; k <= steps; ++k) {
       try {
@@ -299,8 +344,8 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root) {
         totals.assemble_ms += s.assemble_ms;
         totals.solve_ms += s.solve_ms;
         totals.max_solver_iterations = std::max(totals.max_solver_iterations, s.solver_iterations);
-        outputs.record_stats(s);
-        outputs.record_state(*sim, s.step, s.t, totals);
+        outputs->record_stats(s);
+        outputs->record_state(*sim, s.step, s.t, totals);
       } catch (const SimulationError&) {
         throw;
       } catch (const std::exception& e) {
@@ -316,6 +361,17 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root) {
     failure = e.what();
   }
 
+  // Images of the frames simulated so far (also after a failure), with one camera for all.
+  if (outputs && renderer) {
+    try {
+      const int images = outputs->render_frames(*renderer);
+      log_line("rendered " + std::to_string(images) + " frame(s) of " + std::to_string(drawer->fine_triangles()) +
+               " triangles to " + (dir / "frame_*.png").string());
+    } catch (const std::exception& e) {
+      if (failure.empty()) failure = std::string("rendering failed: ") + e.what();
+      else log_line("warning: rendering failed: " + std::string(e.what()));
+    }
+  }
   const double wall = seconds_since(start);
   try {
     write_atomically(dir / "summary.json", summary_json(scene, totals, wall, warnings,

@@ -17,6 +17,6 @@ namespace clothsim {
 // "clothsim: error: <file>: step N (t = ... s): <message>" to stderr, keeps the files written
 // so far, records status "failed" in summary.json and returns 1. Log lines and progress go to
 // stderr, the summary to stdout.
-int run_dynamic_scene(const Scene& scene, const std::filesystem::path& out_root);
+int run_dynamic_scene(const Scene& scene, const std::filesystem::path& out_root, bool render_frames = true);
 
 }  // namespace clothsim

@@ -23,6 +23,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI::Option* end_option =
       app.add_option("--end", end, "Dynamic scenes: simulate to time T [s] instead of time.end")->type_name("T");
+  bool no_render = false;
+  std::string size;
+  app.add_flag("--no-render", no_render, "Write no PNG images");
+  app.add_option("--size", size, "Image size, e.g. 960x720 (replaces render.width/height)")->type_name("WxH");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -32,5 +36,21 @@ int main(int argc, char** argv) {
   }
   clothsim::RunOptions options;
   if (end_option->count() > 0) options.end = end;
+  options.render = !no_render;
+  if (!size.empty()) {
+    const auto x = size.find('x');
+    try {
+      if (x == std::string::npos) throw std::invalid_argument("no x");
+      std::size_t used_w = 0, used_h = 0;
+      options.width = std::stoi(size.substr(0, x), &used_w);
+      options.height = std::stoi(size.substr(x + 1), &used_h);
+      if (used_w != x || used_h != size.size() - x - 1 || options.width < 16 || options.height < 16 ||
+          options.width > 8192 || options.height > 8192)
+        throw std::invalid_argument("range");
+    } catch (const std::exception&) {
+      std::cerr << "clothsim: error: --size: expected WxH with 16 <= W, H <= 8192 (got \"" << size << "\")\n";
+      return 1;
+    }
+  }
   return clothsim::run_scene_file(scene, out, options);
 }

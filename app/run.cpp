@@ -4,6 +4,9 @@
 #include "app/run.hpp"
 
 #include "app/dynamic_run.hpp"
+#include "app/limit_surface_drawer.hpp"
+#include "render/png_io.hpp"
+#include "render/renderer.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/static/static_solve.hpp"
@@ -160,7 +163,9 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     log_line("scene " + scene.name + ": " + std::to_string(scene.problem.mesh.num_vertices()) +
              " control vertices, " + std::to_string(scene.problem.mesh.num_triangles()) + " triangles");
     apply_end_option(scene, options);
-    if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root);
+    if (options.width > 0) scene.render.width = options.width;
+    if (options.height > 0) scene.render.height = options.height;
+    if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root, options.render);
 
     StaticResult result;
     try {
@@ -173,10 +178,21 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     const std::string json = result_json(scene, result);
     const Eigen::MatrixX3d deformed = result.limit_rest + result.limit_displacement;
     const std::string comment = "clothsim: deformed limit surface of scene " + scene.name;
+    std::optional<render::Image> picture;
+    if (options.render) {
+      const ExtendedMesh ext = build_ghost_layer(scene.problem.mesh);
+      const LimitSurfaceDrawer drawer(ext, scene.render, scene.render.width, scene.render.height);
+      const SurfaceSnapshot snapshot = drawer.snapshot(ext.rest + result.extended_displacement);
+      render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+      LimitSurfaceDrawer::extend_bounds(snapshot, lo, hi);
+      render::Renderer renderer(scene.render.width, scene.render.height);
+      picture = renderer.render(drawer.frame(snapshot, drawer.camera(lo, hi), lo[1]));
+    }
     try {
       publish(out_root, scene.name, [&](const fs::path& dir) {
         write_text(dir / "result.json", json);
         write_obj((dir / "limit.obj").string(), deformed, scene.problem.mesh.triangles, comment);
+        if (picture) render::write_png((dir / "limit.png").string(), *picture);
       });
     } catch (const std::exception& e) {
       throw std::runtime_error("cannot write the results to " + (out_root / scene.name).string() + ": " + e.what());

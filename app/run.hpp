@@ -10,6 +10,8 @@ namespace clothsim {
 
 struct RunOptions {
   std::optional<double> end;  // --end T [s]: replaces time.end of a dynamic scene
+  bool render = true;         // --no-render turns PNG output off
+  int width = 0, height = 0;  // --size WxH: replaces render.width/height (0: keep)
 };
 
 // Loads `scene_file`, runs its analysis and writes `out_root`/<scene name>/, replacing an older

@@ -181,6 +181,13 @@ double Simulator::elastic_energy() const { return impl_->elements.energy(); }
 double Simulator::external_work() const { return impl_->work; }
 const Eigen::VectorXd& Simulator::vertex_mass() const { return impl_->mass_per_vertex; }
 
+const ExtendedMesh& Simulator::extended_mesh() const { return impl_->model.extended(); }
+
+Eigen::MatrixX3d Simulator::extended_positions() const {
+  const Impl& m = *impl_;
+  return m.model.extended().rest + m.model.dofs().expand(unflat(m.consistent(flat(m.state.x))));
+}
+
 Eigen::MatrixX3d Simulator::limit_positions() const {
   const Impl& m = *impl_;
   const Eigen::MatrixX3d u = unflat(m.consistent(flat(m.state.x)));

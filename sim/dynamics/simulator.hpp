@@ -17,6 +17,7 @@
 #pragma once
 
 #include "sim/dynamics/dynamic_problem.hpp"
+#include "sim/shell/ghost_layer.hpp"
 
 #include <Eigen/Core>
 
@@ -54,6 +55,10 @@ class Simulator {
   // their difference.
   const Eigen::MatrixX3d& limit_rest() const;
   Eigen::MatrixX3d limit_positions() const;
+  // The control mesh with its ghost layer, and the current positions of all its vertices
+  // (#ext × 3) — what a limit-surface refinement operator acts on.
+  const ExtendedMesh& extended_mesh() const;
+  Eigen::MatrixX3d extended_positions() const;
 
   // Energy bookkeeping [J]: ½ vᵀ M v; the corotated strain energy of the current state; and
   // the work done so far by the external loads (gravity, surface loads, point loads; not by

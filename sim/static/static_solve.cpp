@@ -81,6 +81,7 @@ StaticResult solve_static(const StaticProblem& problem) {
   result.displacement = ext_u.topRows(n);  // tied components take their values from the rule
   result.limit_rest = model.limit_points(model.extended().rest);
   result.limit_displacement = model.limit_points(ext_u);
+  result.extended_displacement = ext_u;
   return result;
 }
 

@@ -39,6 +39,8 @@ struct StaticResult {
   Eigen::MatrixX3d displacement;        // #V × 3 control-vertex displacements [m]
   Eigen::MatrixX3d limit_rest;          // #V × 3 rest positions of the vertices' limit points [m]
   Eigen::MatrixX3d limit_displacement;  // #V × 3 displacement of those limit points [m]
+  Eigen::MatrixX3d extended_displacement;  // displacement of the control mesh with its ghost
+                                           // layer (build_ghost_layer(mesh) order) [m]
   int dofs = 0;                         // free degrees of freedom
   double assemble_seconds = 0.0;        // element matrices, assembly and loads [s]
   double solve_seconds = 0.0;           // factorisation and solve [s]

@@ -1,0 +1,107 @@
+#include "app/limit_surface_drawer.hpp"
+
+#include "render/camera_math.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <utility>
+
+namespace clothsim {
+
+namespace {
+render::Vec3f to_vec3f(const Eigen::Vector3d& v) {
+  return {static_cast<float>(v(0)), static_cast<float>(v(1)), static_cast<float>(v(2))};
+}
+}  // namespace
+
+LimitSurfaceDrawer::LimitSurfaceDrawer(const ExtendedMesh& mesh, const RenderSettings& settings, int width, int height)
+    : refinement_(build_limit_refinement(mesh.rest, mesh.triangles, mesh.num_real_triangles, settings.refine)),
+      num_real_(mesh.num_real),
+      settings_(settings),
+      width_(width),
+      height_(height) {
+  triangles_.reserve(3 * refinement_.triangles.size());
+  for (const Triangle& t : refinement_.triangles)
+    for (int v : t) triangles_.push_back(static_cast<unsigned>(v));
+  std::vector<std::pair<int, int>> edges;
+  for (int t = 0; t < mesh.num_real_triangles; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      edges.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& [a, b] : edges) {
+    edges_.push_back(static_cast<unsigned>(a));
+    edges_.push_back(static_cast<unsigned>(b));
+  }
+}
+
+SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::MatrixX3d& extended_positions) const {
+  Eigen::MatrixX3d p, n;
+  evaluate_limit(refinement_, extended_positions, p, n);
+  SurfaceSnapshot s;
+  s.positions.resize(static_cast<std::size_t>(3 * p.rows()));
+  s.normals.resize(static_cast<std::size_t>(3 * p.rows()));
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      s.positions[static_cast<std::size_t>(3 * i + k)] = static_cast<float>(p(i, k));
+      s.normals[static_cast<std::size_t>(3 * i + k)] = static_cast<float>(n(i, k));
+    }
+  if (settings_.wireframe) {
+    s.control.resize(static_cast<std::size_t>(3 * num_real_));
+    for (int v = 0; v < num_real_; ++v)
+      for (int k = 0; k < 3; ++k) s.control[static_cast<std::size_t>(3 * v + k)] = static_cast<float>(extended_positions(v, k));
+  }
+  return s;
+}
+
+void LimitSurfaceDrawer::extend_bounds(const SurfaceSnapshot& s, render::Vec3f& lo, render::Vec3f& hi) {
+  for (std::size_t i = 0; i + 2 < s.positions.size(); i += 3)
+    for (std::size_t k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], s.positions[i + k]);
+      hi[k] = std::max(hi[k], s.positions[i + k]);
+    }
+}
+
+render::Camera LimitSurfaceDrawer::camera(const render::Vec3f& lo, const render::Vec3f& hi) const {
+  if (settings_.has_camera) {
+    render::Camera c;
+    c.eye = to_vec3f(settings_.eye);
+    c.target = to_vec3f(settings_.target);
+    c.up = to_vec3f(settings_.up);
+    c.fov_deg = static_cast<float>(settings_.fov_deg);
+    return c;
+  }
+  // Looking along −z, a little from above, with +y up.
+  return render::frame_bounds(lo, hi, static_cast<float>(settings_.fov_deg), render::Vec3f{0.35f, -0.35f, -1.0f},
+                              render::Vec3f{0, 1, 0}, static_cast<float>(width_) / static_cast<float>(height_));
+}
+
+render::Frame LimitSurfaceDrawer::frame(const SurfaceSnapshot& s, const render::Camera& camera,
+                                        float ground_height) const {
+  render::Frame f;
+  f.width = width_;
+  f.height = height_;
+  f.camera = camera;
+  f.background = to_vec3f(settings_.background);
+  render::Mesh mesh;
+  mesh.positions = s.positions;
+  mesh.normals = s.normals;
+  mesh.triangles = triangles_;
+  mesh.color = to_vec3f(settings_.color);
+  mesh.back_color = to_vec3f(settings_.back_color);
+  f.meshes.push_back(std::move(mesh));
+  if (settings_.wireframe && !s.control.empty()) {
+    render::Lines lines;
+    lines.positions = s.control;
+    lines.segments = edges_;
+    lines.color = {0.15f, 0.15f, 0.15f};
+    f.lines.push_back(std::move(lines));
+  }
+  f.ground = settings_.ground;
+  f.ground_height = ground_height;
+  return f;
+}
+
+}  // namespace clothsim

@@ -1,0 +1,157 @@
+// Camera geometry: look-at and perspective matrices, point projection, box framing.
+#include "render/camera_math.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace clothsim::render {
+namespace {
+
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+};
+
+Vec3d to_d(const Vec3f& v) { return {v[0], v[1], v[2]}; }
+Vec3d operator-(const Vec3d& a, const Vec3d& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+Vec3d operator+(const Vec3d& a, const Vec3d& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Vec3d operator*(double s, const Vec3d& a) { return {s * a.x, s * a.y, s * a.z}; }
+double dot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+Vec3d cross(const Vec3d& a, const Vec3d& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+double norm(const Vec3d& a) { return std::sqrt(dot(a, a)); }
+bool finite(const Vec3d& a) {
+  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+}
+
+// Unit right, up and backward (−forward) axes of a camera looking along `forward`.
+struct Basis {
+  Vec3d right, up, back;
+};
+
+Basis camera_basis(const Vec3d& forward, const Vec3d& up_hint) {
+  const Vec3d f = (1.0 / norm(forward)) * forward;
+  Vec3d r = cross(f, up_hint);
+  // An up hint (nearly) parallel to the viewing direction: use the world axis least aligned
+  // with it instead.
+  if (norm(r) < 1e-6 * std::max(norm(up_hint), 1e-300)) {
+    const Vec3d candidates[3] = {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
+    const Vec3d* best = &candidates[0];
+    for (const Vec3d& c : candidates) {
+      if (std::abs(dot(c, f)) < std::abs(dot(*best, f))) best = &c;
+    }
+    r = cross(f, *best);
+  }
+  r = (1.0 / norm(r)) * r;
+  return {r, cross(r, f), -1.0 * f};
+}
+
+Mat4f to_float(const double (&m)[16]) {
+  Mat4f out{};
+  for (std::size_t i = 0; i < 16; ++i) out[i] = static_cast<float>(m[i]);
+  return out;
+}
+
+}  // namespace
+
+Mat4f view_matrix(const Camera& camera) {
+  const Vec3d eye = to_d(camera.eye);
+  const Vec3d target = to_d(camera.target);
+  const Vec3d up = to_d(camera.up);
+  if (!finite(eye) || !finite(target) || !finite(up)) {
+    throw std::invalid_argument("render camera: eye, target and up must be finite");
+  }
+  const Vec3d forward = target - eye;
+  if (!(norm(forward) > 0)) {
+    throw std::invalid_argument("render camera: eye and target coincide");
+  }
+  const Basis b = camera_basis(forward, up);
+  // Rows of the rotation are the camera axes; translation moves the eye to the origin.
+  const double m[16] = {b.right.x,          b.up.x,          b.back.x,          0,  //
+                        b.right.y,          b.up.y,          b.back.y,          0,  //
+                        b.right.z,          b.up.z,          b.back.z,          0,  //
+                        -dot(b.right, eye), -dot(b.up, eye), -dot(b.back, eye), 1};
+  return to_float(m);
+}
+
+Mat4f projection_matrix(float fov_deg, float aspect, float near_plane, float far_plane) {
+  const double f = 1.0 / std::tan(0.5 * static_cast<double>(fov_deg) * std::numbers::pi / 180.0);
+  const double n = near_plane;
+  const double fa = far_plane;
+  const double m[16] = {f / static_cast<double>(aspect),
+                        0,
+                        0,
+                        0,  //
+                        0,
+                        f,
+                        0,
+                        0,  //
+                        0,
+                        0,
+                        (fa + n) / (n - fa),
+                        -1,  //
+                        0,
+                        0,
+                        2 * fa * n / (n - fa),
+                        0};
+  return to_float(m);
+}
+
+PixelPosition project_to_pixel(const Camera& camera, int width, int height, const Vec3f& point) {
+  const Mat4f v = view_matrix(camera);
+  const double x = v[0] * point[0] + v[4] * point[1] + v[8] * point[2] + v[12];
+  const double y = v[1] * point[0] + v[5] * point[1] + v[9] * point[2] + v[13];
+  const double z = v[2] * point[0] + v[6] * point[1] + v[10] * point[2] + v[14];
+  const double depth = -z;
+  const double f =
+      1.0 / std::tan(0.5 * static_cast<double>(camera.fov_deg) * std::numbers::pi / 180.0);
+  const double aspect = static_cast<double>(width) / static_cast<double>(height);
+  PixelPosition p;
+  p.depth = static_cast<float>(depth);
+  if (depth > 0) {
+    const double ndc_x = f / aspect * x / depth;
+    const double ndc_y = f * y / depth;
+    p.x = static_cast<float>(0.5 * (ndc_x + 1.0) * width);
+    p.y = static_cast<float>(0.5 * (1.0 - ndc_y) * height);
+  }
+  return p;
+}
+
+Camera frame_bounds(const Vec3f& lo, const Vec3f& hi, float fov_deg, Vec3f view_direction, Vec3f up,
+                    float aspect) {
+  const Vec3d l = to_d(lo);
+  const Vec3d h = to_d(hi);
+  const Vec3d dir = to_d(view_direction);
+  if (!finite(l) || !finite(h)) throw std::invalid_argument("frame_bounds: bounds not finite");
+  if (!finite(dir) || !(norm(dir) > 0)) {
+    throw std::invalid_argument("frame_bounds: view direction must be finite and non-zero");
+  }
+  if (!(fov_deg > 0 && fov_deg < 180)) {
+    throw std::invalid_argument("frame_bounds: fov_deg must lie in (0, 180), got " +
+                                std::to_string(fov_deg));
+  }
+  if (!(aspect > 0) || !std::isfinite(aspect)) {
+    throw std::invalid_argument("frame_bounds: aspect must be positive");
+  }
+  const Vec3d centre = 0.5 * (l + h);
+  double radius = 0.5 * norm(h - l);
+  if (!(radius > 0)) radius = 1e-3;  // a point: frame a tiny sphere around it
+  const double half_v = 0.5 * static_cast<double>(fov_deg) * std::numbers::pi / 180.0;
+  const double half_h = std::atan(std::tan(half_v) * static_cast<double>(aspect));
+  const double margin = 1.05;
+  const double distance = margin * radius / std::sin(std::min(half_v, half_h));
+  const Vec3d eye = centre - (distance / norm(dir)) * dir;
+  const Basis b = camera_basis(dir, to_d(up));
+  Camera camera;
+  camera.eye = {static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z)};
+  camera.target = {static_cast<float>(centre.x), static_cast<float>(centre.y),
+                   static_cast<float>(centre.z)};
+  camera.up = {static_cast<float>(b.up.x), static_cast<float>(b.up.y), static_cast<float>(b.up.z)};
+  camera.fov_deg = fov_deg;
+  return camera;
+}
+
+}  // namespace clothsim::render

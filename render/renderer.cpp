@@ -1,0 +1,713 @@
+// OSMesa-backed implementation of Renderer: context set-up, shaders, multisampled framebuffers,
+// per-frame upload and drawing of meshes, ground and lines, and read-back.
+#include "render/renderer.hpp"
+
+#include <GL/osmesa.h>  // includes GL/gl.h and GL/glext.h; GL_GLEXT_PROTOTYPES is set by CMake
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace clothsim::render {
+namespace {
+
+constexpr const char* kSurfaceVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_view;
+uniform mat4 u_projection;
+out vec3 v_view_position;
+out vec3 v_view_normal;
+out vec3 v_world_position;
+void main() {
+  vec4 p = u_view * vec4(a_position, 1.0);
+  v_view_position = p.xyz;
+  v_view_normal = mat3(u_view) * a_normal;  // the view transform is rigid
+  v_world_position = a_position;
+  gl_Position = u_projection * p;
+}
+)";
+
+// Blinn-Phong with a key and a fill light fixed in camera space (the camera looks down -z).
+// Back faces use the back colour and the flipped normal. Vertices without a usable normal fall
+// back to the facet normal from screen-space derivatives. The ground is matte and fades into
+// the background with distance from its centre.
+constexpr const char* kSurfaceFragmentShader = R"(#version 330 core
+in vec3 v_view_position;
+in vec3 v_view_normal;
+in vec3 v_world_position;
+uniform vec3 u_front_color;
+uniform vec3 u_back_color;
+uniform int u_is_ground;
+uniform vec3 u_background;
+uniform vec2 u_ground_centre;
+uniform vec2 u_ground_fade;
+out vec4 o_color;
+
+const vec3 kKeyDirection = normalize(vec3(-0.45, 0.6, 0.75));
+const vec3 kFillDirection = normalize(vec3(0.6, -0.2, 0.8));
+const float kKey = 0.72;
+const float kFill = 0.28;
+const float kAmbient = 0.16;
+const float kSpecular = 0.22;
+const float kShininess = 48.0;
+
+vec3 light(vec3 n, vec3 v, vec3 l, float strength, vec3 base) {
+  float diffuse = max(dot(n, l), 0.0);
+  vec3 h = normalize(l + v);
+  float specular = diffuse > 0.0 ? pow(max(dot(n, h), 0.0), kShininess) : 0.0;
+  return strength * (diffuse * base + kSpecular * specular * vec3(1.0));
+}
+
+void main() {
+  vec3 facet = cross(dFdx(v_view_position), dFdy(v_view_position));  // towards the viewer
+  float facet_length = length(facet);
+  facet = facet_length > 0.0 ? facet / facet_length : vec3(0.0, 0.0, 1.0);
+  bool front = gl_FrontFacing;
+  float normal_length = length(v_view_normal);
+  vec3 n;
+  if (normal_length > 1e-12) {
+    n = v_view_normal / normal_length;
+    if (!front) n = -n;
+  } else {
+    n = facet;
+  }
+  vec3 base = (u_is_ground != 0 || front) ? u_front_color : u_back_color;
+  vec3 v = normalize(-v_view_position);
+  vec3 color;
+  if (u_is_ground == 0) {
+    color = kAmbient * base + light(n, v, kKeyDirection, kKey, base) +
+            light(n, v, kFillDirection, kFill, base);
+  } else {
+    // Matte and mostly ambient, so that it stays light grey from any viewing angle.
+    color = base * (0.45 + 0.55 * max(dot(n, kKeyDirection), 0.0));
+    float d = distance(v_world_position.xz, u_ground_centre);
+    color = mix(color, u_background, smoothstep(u_ground_fade.x, u_ground_fade.y, d));
+  }
+  o_color = vec4(clamp(color, 0.0, 1.0), 1.0);
+}
+)";
+
+constexpr const char* kLineVertexShader = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+uniform mat4 u_view;
+uniform mat4 u_projection;
+void main() { gl_Position = u_projection * (u_view * vec4(a_position, 1.0)); }
+)";
+
+constexpr const char* kLineFragmentShader = R"(#version 330 core
+uniform vec3 u_color;
+out vec4 o_color;
+void main() { o_color = vec4(u_color, 1.0); }
+)";
+
+constexpr float kGroundGrey = 0.92f;
+
+std::string gl_error_name(GLenum error) {
+  switch (error) {
+    case GL_INVALID_ENUM:
+      return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE:
+      return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION:
+      return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION:
+      return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY:
+      return "GL_OUT_OF_MEMORY";
+    default:
+      return "GL error 0x" + std::to_string(error);
+  }
+}
+
+void check_gl(const char* what) {
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) {
+    throw std::runtime_error(std::string("Renderer: ") + what + " failed: " + gl_error_name(error));
+  }
+}
+
+std::string framebuffer_status_name(GLenum status) {
+  switch (status) {
+    case GL_FRAMEBUFFER_UNDEFINED:
+      return "GL_FRAMEBUFFER_UNDEFINED";
+    case GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT:
+      return "GL_FRAMEBUFFER_INCOMPLETE_ATTACHMENT";
+    case GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT:
+      return "GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT";
+    case GL_FRAMEBUFFER_UNSUPPORTED:
+      return "GL_FRAMEBUFFER_UNSUPPORTED";
+    case GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE:
+      return "GL_FRAMEBUFFER_INCOMPLETE_MULTISAMPLE";
+    default:
+      return "status 0x" + std::to_string(status);
+  }
+}
+
+GLuint compile_shader(GLenum type, const char* source, const char* name) {
+  const GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    GLint length = 0;
+    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+    glGetShaderInfoLog(shader, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    glDeleteShader(shader);
+    throw std::runtime_error(std::string("Renderer: compiling the ") + name +
+                             " shader failed: " + log.c_str());
+  }
+  return shader;
+}
+
+GLuint link_program(const char* vertex_source, const char* fragment_source, const char* name) {
+  const GLuint vs = compile_shader(GL_VERTEX_SHADER, vertex_source, name);
+  GLuint fs = 0;
+  try {
+    fs = compile_shader(GL_FRAGMENT_SHADER, fragment_source, name);
+  } catch (...) {
+    glDeleteShader(vs);
+    throw;
+  }
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = GL_FALSE;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    GLint length = 0;
+    glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<std::size_t>(std::max(length, 1)), '\0');
+    glGetProgramInfoLog(program, static_cast<GLsizei>(log.size()), nullptr, log.data());
+    glDeleteProgram(program);
+    throw std::runtime_error(std::string("Renderer: linking the ") + name +
+                             " shader program failed: " + log.c_str());
+  }
+  return program;
+}
+
+GLint uniform(GLuint program, const char* name) {
+  const GLint location = glGetUniformLocation(program, name);
+  if (location < 0) {
+    throw std::runtime_error(std::string("Renderer: shader uniform ") + name + " not found");
+  }
+  return location;
+}
+
+void require(bool condition, const std::string& message) {
+  if (!condition) throw std::invalid_argument("Renderer::render: " + message);
+}
+
+bool finite3(const Vec3f& v) {
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
+
+void validate_vertices(const std::vector<float>& positions, const std::string& what) {
+  require(positions.size() % 3 == 0, what + ": positions.size() is not a multiple of 3");
+  require(positions.size() / 3 <= std::numeric_limits<unsigned>::max(),
+          what + ": too many vertices");
+  const bool all_finite =
+      std::all_of(positions.begin(), positions.end(), [](float x) { return std::isfinite(x); });
+  require(all_finite, what + ": non-finite position");
+}
+
+void validate_indices(const std::vector<unsigned>& indices, std::size_t per_element,
+                      std::size_t vertex_count, const std::string& what) {
+  require(indices.size() % per_element == 0,
+          what + ": index count is not a multiple of " + std::to_string(per_element));
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    if (indices[i] >= vertex_count) {  // message built only on failure: this loop is hot
+      require(false, what + ": index " + std::to_string(indices[i]) + " at position " +
+                         std::to_string(i) + " is out of range (" + std::to_string(vertex_count) +
+                         " vertices)");
+    }
+  }
+}
+
+// Interleaved [x y z nx ny nz] per vertex. Missing normals are area-weighted sums of the
+// adjacent triangle normals, normalised (zero for isolated vertices: the shader then uses the
+// facet normal).
+std::vector<float> interleave(const Mesh& mesh) {
+  const std::size_t n = mesh.positions.size() / 3;
+  std::vector<float> normals;
+  const std::vector<float>* source = &mesh.normals;
+  if (mesh.normals.empty()) {
+    std::vector<double> sum(3 * n, 0.0);
+    for (std::size_t t = 0; t + 2 < mesh.triangles.size(); t += 3) {
+      const std::size_t a = mesh.triangles[t], b = mesh.triangles[t + 1], c = mesh.triangles[t + 2];
+      double e1[3], e2[3];
+      for (std::size_t k = 0; k < 3; ++k) {
+        e1[k] = static_cast<double>(mesh.positions[3 * b + k]) - mesh.positions[3 * a + k];
+        e2[k] = static_cast<double>(mesh.positions[3 * c + k]) - mesh.positions[3 * a + k];
+      }
+      const double cr[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                            e1[0] * e2[1] - e1[1] * e2[0]};
+      for (const std::size_t v : {a, b, c}) {
+        for (std::size_t k = 0; k < 3; ++k) sum[3 * v + k] += cr[k];
+      }
+    }
+    normals.resize(3 * n);
+    for (std::size_t v = 0; v < n; ++v) {
+      const double len = std::sqrt(sum[3 * v] * sum[3 * v] + sum[3 * v + 1] * sum[3 * v + 1] +
+                                   sum[3 * v + 2] * sum[3 * v + 2]);
+      for (std::size_t k = 0; k < 3; ++k) {
+        normals[3 * v + k] = len > 0 ? static_cast<float>(sum[3 * v + k] / len) : 0.0f;
+      }
+    }
+    source = &normals;
+  }
+  std::vector<float> out(6 * n);
+  for (std::size_t v = 0; v < n; ++v) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      out[6 * v + k] = mesh.positions[3 * v + k];
+      out[6 * v + 3 + k] = (*source)[3 * v + k];
+    }
+  }
+  return out;
+}
+
+struct DepthRange {
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -std::numeric_limits<double>::infinity();
+  void add(const Mat4f& view, float x, float y, float z) {
+    const double depth = -(static_cast<double>(view[2]) * x + static_cast<double>(view[6]) * y +
+                           static_cast<double>(view[10]) * z + static_cast<double>(view[14]));
+    lo = std::min(lo, depth);
+    hi = std::max(hi, depth);
+  }
+  void add_all(const Mat4f& view, const std::vector<float>& positions) {
+    for (std::size_t i = 0; i + 2 < positions.size(); i += 3) {
+      add(view, positions[i], positions[i + 1], positions[i + 2]);
+    }
+  }
+};
+
+}  // namespace
+
+struct Renderer::Impl {
+  OSMesaContext context = nullptr;
+  std::vector<unsigned char> default_buffer;  // OSMesa's window buffer (unused: we draw to FBOs)
+  int max_width = 0;
+  int max_height = 0;
+  RendererInfo info;
+  float line_width_range[2] = {1, 1};
+
+  GLuint surface_program = 0;
+  GLuint line_program = 0;
+  GLint surface_view = -1, surface_projection = -1, surface_front = -1, surface_back = -1,
+        surface_is_ground = -1, surface_background = -1, surface_ground_centre = -1,
+        surface_ground_fade = -1;
+  GLint line_view = -1, line_projection = -1, line_color = -1;
+
+  GLuint vao = 0;
+  GLuint vertex_buffer = 0;
+  GLuint index_buffer = 0;
+
+  // Framebuffers, (re)allocated for the current frame size.
+  int fb_width = 0;
+  int fb_height = 0;
+  GLuint ms_fbo = 0, ms_color = 0, ms_depth = 0;
+  GLuint resolve_fbo = 0, resolve_color = 0;
+  std::vector<std::uint8_t> read_buffer;  // bottom-up RGBA rows from glReadPixels
+
+  Impl(int width, int height, int samples);
+  ~Impl();
+  void make_current();
+  void create_context();
+  void destroy_context();
+  void setup_pipeline(int requested_samples);
+  void ensure_framebuffers(int width, int height);
+  void delete_framebuffers();
+  Image render(const Frame& frame);
+  void draw_mesh(const Mesh& mesh);
+  void draw_lines(const Lines& lines);
+  void draw_ground(const Frame& frame, const Vec3f& centre, float half_size);
+};
+
+Renderer::Impl::Impl(int width, int height, int samples)
+    : default_buffer(4 * 4 * 4), max_width(width), max_height(height) {
+  if (width <= 0 || height <= 0) {
+    throw std::invalid_argument("Renderer: maximum size must be positive, got " +
+                                std::to_string(width) + " x " + std::to_string(height));
+  }
+  create_context();
+  try {
+    setup_pipeline(samples);
+  } catch (...) {
+    destroy_context();
+    throw;
+  }
+}
+
+Renderer::Impl::~Impl() { destroy_context(); }
+
+void Renderer::Impl::destroy_context() {
+  if (context == nullptr) return;
+  // Destroying the context frees every GL object it owns.
+  if (OSMesaGetCurrentContext() == context) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+  OSMesaDestroyContext(context);
+  context = nullptr;
+}
+
+void Renderer::Impl::create_context() {
+  // GL 3.3 core profile first, then a compatibility profile (which also runs the 330 core
+  // shaders on Mesa), then a legacy context as a last resort.
+  for (const int profile : {OSMESA_CORE_PROFILE, OSMESA_COMPAT_PROFILE}) {
+    const int attributes[] = {OSMESA_FORMAT,
+                              OSMESA_RGBA,
+                              OSMESA_DEPTH_BITS,
+                              0,
+                              OSMESA_STENCIL_BITS,
+                              0,
+                              OSMESA_ACCUM_BITS,
+                              0,
+                              OSMESA_PROFILE,
+                              profile,
+                              OSMESA_CONTEXT_MAJOR_VERSION,
+                              3,
+                              OSMESA_CONTEXT_MINOR_VERSION,
+                              3,
+                              0};
+    context = OSMesaCreateContextAttribs(attributes, nullptr);
+    if (context != nullptr) {
+      info.core_profile = profile == OSMESA_CORE_PROFILE;
+      break;
+    }
+  }
+  if (context == nullptr) context = OSMesaCreateContextExt(OSMESA_RGBA, 0, 0, 0, nullptr);
+  if (context == nullptr) {
+    throw std::runtime_error(
+        "Renderer: OSMesa could not create an OpenGL context (is libOSMesa installed, and is "
+        "libGL not linked next to it?)");
+  }
+  try {
+    make_current();
+  } catch (...) {
+    destroy_context();
+    throw;
+  }
+}
+
+void Renderer::Impl::make_current() {
+  if (OSMesaGetCurrentContext() == context) return;
+  if (!OSMesaMakeCurrent(context, default_buffer.data(), GL_UNSIGNED_BYTE, 4, 4)) {
+    throw std::runtime_error("Renderer: OSMesaMakeCurrent failed");
+  }
+}
+
+void Renderer::Impl::setup_pipeline(int requested_samples) {
+  GLint major = 0, minor = 0;
+  glGetIntegerv(GL_MAJOR_VERSION, &major);
+  glGetIntegerv(GL_MINOR_VERSION, &minor);
+  if (glGetError() != GL_NO_ERROR || major < 3 || (major == 3 && minor < 3)) {
+    const GLubyte* version = glGetString(GL_VERSION);
+    throw std::runtime_error(
+        std::string("Renderer: OpenGL 3.3 or newer is required, OSMesa provides ") +
+        (version != nullptr ? reinterpret_cast<const char*>(version) : "an unknown version"));
+  }
+  info.gl_major = major;
+  info.gl_minor = minor;
+
+  GLint max_samples = 1, max_renderbuffer = 0, max_viewport[2] = {0, 0};
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
+  glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, line_width_range);
+  check_gl("querying implementation limits");
+  info.samples = std::clamp(requested_samples, 1, std::max(max_samples, 1));
+  if (max_width > std::min(max_renderbuffer, max_viewport[0]) ||
+      max_height > std::min(max_renderbuffer, max_viewport[1])) {
+    throw std::runtime_error("Renderer: maximum size " + std::to_string(max_width) + " x " +
+                             std::to_string(max_height) + " exceeds the GL limit of " +
+                             std::to_string(std::min(max_renderbuffer, max_viewport[0])) + " x " +
+                             std::to_string(std::min(max_renderbuffer, max_viewport[1])));
+  }
+
+  surface_program = link_program(kSurfaceVertexShader, kSurfaceFragmentShader, "surface");
+  surface_view = uniform(surface_program, "u_view");
+  surface_projection = uniform(surface_program, "u_projection");
+  surface_front = uniform(surface_program, "u_front_color");
+  surface_back = uniform(surface_program, "u_back_color");
+  surface_is_ground = uniform(surface_program, "u_is_ground");
+  surface_background = uniform(surface_program, "u_background");
+  surface_ground_centre = uniform(surface_program, "u_ground_centre");
+  surface_ground_fade = uniform(surface_program, "u_ground_fade");
+  line_program = link_program(kLineVertexShader, kLineFragmentShader, "line");
+  line_view = uniform(line_program, "u_view");
+  line_projection = uniform(line_program, "u_projection");
+  line_color = uniform(line_program, "u_color");
+
+  // The core profile draws nothing without a bound vertex array object.
+  glGenVertexArrays(1, &vao);
+  glGenBuffers(1, &vertex_buffer);
+  glGenBuffers(1, &index_buffer);
+  glBindVertexArray(vao);
+  glBindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
+  glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, index_buffer);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);
+  glDisable(GL_CULL_FACE);
+  glEnable(GL_MULTISAMPLE);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  check_gl("setting up the GL pipeline");
+}
+
+void Renderer::Impl::delete_framebuffers() {
+  glDeleteFramebuffers(1, &ms_fbo);
+  glDeleteFramebuffers(1, &resolve_fbo);
+  glDeleteRenderbuffers(1, &ms_color);
+  glDeleteRenderbuffers(1, &ms_depth);
+  glDeleteRenderbuffers(1, &resolve_color);
+  ms_fbo = resolve_fbo = ms_color = ms_depth = resolve_color = 0;
+  fb_width = fb_height = 0;
+}
+
+void Renderer::Impl::ensure_framebuffers(int width, int height) {
+  if (width == fb_width && height == fb_height) return;
+  delete_framebuffers();
+  const GLsizei samples = info.samples;
+
+  glGenRenderbuffers(1, &ms_color);
+  glBindRenderbuffer(GL_RENDERBUFFER, ms_color);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA8, width, height);
+  glGenRenderbuffers(1, &ms_depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, ms_depth);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT32F, width, height);
+  glGenFramebuffers(1, &ms_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ms_color);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ms_depth);
+  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    delete_framebuffers();
+    throw std::runtime_error("Renderer: the " + std::to_string(samples) +
+                             "-sample framebuffer of " + std::to_string(width) + " x " +
+                             std::to_string(height) +
+                             " is incomplete: " + framebuffer_status_name(status));
+  }
+
+  glGenRenderbuffers(1, &resolve_color);
+  glBindRenderbuffer(GL_RENDERBUFFER, resolve_color);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  glGenFramebuffers(1, &resolve_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, resolve_color);
+  status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    delete_framebuffers();
+    throw std::runtime_error("Renderer: the resolve framebuffer of " + std::to_string(width) +
+                             " x " + std::to_string(height) +
+                             " is incomplete: " + framebuffer_status_name(status));
+  }
+  check_gl("allocating framebuffers");
+  fb_width = width;
+  fb_height = height;
+}
+
+void Renderer::Impl::draw_mesh(const Mesh& mesh) {
+  if (mesh.triangles.empty()) return;
+  const std::vector<float> vertices = interleave(mesh);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)),
+               vertices.data(), GL_STREAM_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(unsigned)),
+               mesh.triangles.data(), GL_STREAM_DRAW);
+  glEnableVertexAttribArray(0);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                        reinterpret_cast<const void*>(3 * sizeof(float)));
+  glUniform1i(surface_is_ground, 0);
+  glUniform3fv(surface_front, 1, mesh.color.data());
+  glUniform3fv(surface_back, 1, mesh.back_color.data());
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size()), GL_UNSIGNED_INT,
+                 nullptr);
+}
+
+void Renderer::Impl::draw_ground(const Frame& frame, const Vec3f& centre, float half_size) {
+  const float y = frame.ground_height;
+  const float x0 = centre[0] - half_size, x1 = centre[0] + half_size;
+  const float z0 = centre[2] - half_size, z1 = centre[2] + half_size;
+  // Counter-clockwise seen from above (+y).
+  const float vertices[] = {x0, y, z0, 0, 1, 0, x0, y, z1, 0, 1, 0,
+                            x1, y, z1, 0, 1, 0, x1, y, z0, 0, 1, 0};
+  const unsigned indices[] = {0, 1, 2, 0, 2, 3};
+  glBufferData(GL_ARRAY_BUFFER, sizeof(vertices), vertices, GL_STREAM_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof(indices), indices, GL_STREAM_DRAW);
+  glEnableVertexAttribArray(0);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
+                        reinterpret_cast<const void*>(3 * sizeof(float)));
+  const float grey[3] = {kGroundGrey, kGroundGrey, kGroundGrey};
+  glUniform1i(surface_is_ground, 1);
+  glUniform3fv(surface_front, 1, grey);
+  glUniform3fv(surface_back, 1, grey);
+  glUniform2f(surface_ground_centre, centre[0], centre[2]);
+  glUniform2f(surface_ground_fade, 0.25f * half_size, 0.8f * half_size);
+  glDrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, nullptr);
+}
+
+void Renderer::Impl::draw_lines(const Lines& lines) {
+  if (lines.segments.empty()) return;
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(lines.positions.size() * sizeof(float)),
+               lines.positions.data(), GL_STREAM_DRAW);
+  glBufferData(GL_ELEMENT_ARRAY_BUFFER,
+               static_cast<GLsizeiptr>(lines.segments.size() * sizeof(unsigned)),
+               lines.segments.data(), GL_STREAM_DRAW);
+  glEnableVertexAttribArray(0);
+  glDisableVertexAttribArray(1);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+  glUniform3fv(line_color, 1, lines.color.data());
+  glLineWidth(std::clamp(lines.width, line_width_range[0], line_width_range[1]));
+  glDrawElements(GL_LINES, static_cast<GLsizei>(lines.segments.size()), GL_UNSIGNED_INT, nullptr);
+}
+
+Image Renderer::Impl::render(const Frame& frame) {
+  // Validate everything before touching GL.
+  require(
+      frame.width > 0 && frame.height > 0 && frame.width <= max_width && frame.height <= max_height,
+      "frame size " + std::to_string(frame.width) + " x " + std::to_string(frame.height) +
+          " outside 1 x 1 .. " + std::to_string(max_width) + " x " + std::to_string(max_height));
+  require(frame.camera.fov_deg > 0 && frame.camera.fov_deg < 180,
+          "camera fov_deg must lie in (0, 180)");
+  require(finite3(frame.background) && std::isfinite(frame.ground_height),
+          "background and ground height must be finite");
+  for (std::size_t i = 0; i < frame.meshes.size(); ++i) {
+    const Mesh& mesh = frame.meshes[i];
+    const std::string what = "mesh " + std::to_string(i);
+    validate_vertices(mesh.positions, what);
+    require(mesh.normals.empty() || mesh.normals.size() == mesh.positions.size(),
+            what + ": normals must be empty or have as many entries as positions");
+    validate_indices(mesh.triangles, 3, mesh.positions.size() / 3, what + " triangles");
+  }
+  for (std::size_t i = 0; i < frame.lines.size(); ++i) {
+    const Lines& lines = frame.lines[i];
+    const std::string what = "lines " + std::to_string(i);
+    validate_vertices(lines.positions, what);
+    validate_indices(lines.segments, 2, lines.positions.size() / 3, what + " segments");
+  }
+  const Mat4f view = view_matrix(frame.camera);  // throws for a degenerate camera
+
+  // Ground: a square centred below the camera target, sized from the viewing distance so that
+  // it (and its fade) stays fixed while the camera is.
+  double distance = 0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const double d = static_cast<double>(frame.camera.eye[k]) - frame.camera.target[k];
+    distance += d * d;
+  }
+  distance = std::sqrt(distance);
+  const float ground_half_size = static_cast<float>(12.0 * distance);
+  const Vec3f ground_centre = {frame.camera.target[0], frame.ground_height, frame.camera.target[2]};
+
+  // Near and far planes hugging the visible geometry.
+  DepthRange range;
+  for (const Mesh& mesh : frame.meshes) range.add_all(view, mesh.positions);
+  for (const Lines& lines : frame.lines) range.add_all(view, lines.positions);
+  if (frame.ground) {
+    for (const float sx : {-1.0f, 1.0f}) {
+      for (const float sz : {-1.0f, 1.0f}) {
+        range.add(view, ground_centre[0] + sx * ground_half_size, frame.ground_height,
+                  ground_centre[2] + sz * ground_half_size);
+      }
+    }
+  }
+  double far_plane = 100.0 * distance;  // nothing in front of the camera: any planes do
+  double near_plane = 0.01 * distance;
+  if (range.hi > 0) {
+    far_plane = range.hi * 1.02 + 1e-6 * distance;
+    near_plane = std::max(range.lo * 0.98, far_plane * 1e-4);
+  }
+  const Mat4f projection = projection_matrix(
+      frame.camera.fov_deg, static_cast<float>(frame.width) / static_cast<float>(frame.height),
+      static_cast<float>(near_plane), static_cast<float>(far_plane));
+
+  make_current();
+  ensure_framebuffers(frame.width, frame.height);
+  glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+  glViewport(0, 0, frame.width, frame.height);
+  glClearColor(frame.background[0], frame.background[1], frame.background[2], 1.0f);
+  glClearDepth(1.0);
+  glDepthMask(GL_TRUE);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glBindVertexArray(vao);
+
+  glUseProgram(surface_program);
+  glUniformMatrix4fv(surface_view, 1, GL_FALSE, view.data());
+  glUniformMatrix4fv(surface_projection, 1, GL_FALSE, projection.data());
+  glUniform3fv(surface_background, 1, frame.background.data());
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  // Meshes are pushed slightly back so that coincident wireframe lines win the depth test;
+  // the ground further still so that cloth lying on it stays visible.
+  glPolygonOffset(1.0f, 1.0f);
+  for (const Mesh& mesh : frame.meshes) draw_mesh(mesh);
+  if (frame.ground) {
+    glPolygonOffset(4.0f, 16.0f);
+    draw_ground(frame, ground_centre, ground_half_size);
+  }
+  glDisable(GL_POLYGON_OFFSET_FILL);
+
+  if (!frame.lines.empty()) {
+    glUseProgram(line_program);
+    glUniformMatrix4fv(line_view, 1, GL_FALSE, view.data());
+    glUniformMatrix4fv(line_projection, 1, GL_FALSE, projection.data());
+    for (const Lines& lines : frame.lines) draw_lines(lines);
+  }
+  check_gl("drawing");
+
+  // Resolve the samples, then read back (GL rows run bottom-up: flip to top row first).
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
+  glBlitFramebuffer(0, 0, frame.width, frame.height, 0, 0, frame.width, frame.height,
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  // RGBA is Mesa's fast read-back path (a plain copy); dropping alpha here is cheaper than
+  // letting GL convert to RGB.
+  const std::size_t width = static_cast<std::size_t>(frame.width);
+  const std::size_t rows = static_cast<std::size_t>(frame.height);
+  read_buffer.resize(4 * width * rows);
+  glReadPixels(0, 0, frame.width, frame.height, GL_RGBA, GL_UNSIGNED_BYTE, read_buffer.data());
+  check_gl("reading back the image");
+
+  Image image;
+  image.width = frame.width;
+  image.height = frame.height;
+  image.rgb.resize(3 * width * rows);
+  for (std::size_t y = 0; y < rows; ++y) {
+    const std::uint8_t* source = read_buffer.data() + 4 * width * (rows - 1 - y);
+    std::uint8_t* target = image.rgb.data() + 3 * width * y;
+    for (std::size_t x = 0; x < width; ++x) {
+      target[3 * x] = source[4 * x];
+      target[3 * x + 1] = source[4 * x + 1];
+      target[3 * x + 2] = source[4 * x + 2];
+    }
+  }
+  return image;
+}
+
+Renderer::Renderer(int max_width, int max_height, int samples)
+    : impl_(std::make_unique<Impl>(max_width, max_height, samples)) {}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+Image Renderer::render(const Frame& frame) {
+  if (!impl_) throw std::logic_error("Renderer::render: renderer was moved from");
+  return impl_->render(frame);
+}
+
+const RendererInfo& Renderer::info() const { return impl_->info; }
+int Renderer::max_width() const { return impl_->max_width; }
+int Renderer::max_height() const { return impl_->max_height; }
+
+}  // namespace clothsim::render

@@ -1,0 +1,54 @@
+// Off-screen renderer: draws a Frame into an RGB image with Mesa's OSMesa (software GL, GL 3.3+
+// core-profile shaders, multisampled anti-aliasing, Blinn-Phong two-sided lighting). The output
+// is deterministic: the same Frame gives byte-identical images on every run. frame_bounds()
+// (declared in camera_math.hpp, included here) fixes one camera for a whole animation.
+#pragma once
+
+#include <memory>
+
+#include "render/camera_math.hpp"
+#include "render/frame.hpp"
+#include "render/image.hpp"
+
+namespace clothsim::render {
+
+struct RendererInfo {
+  bool core_profile = false;  // false: fell back to a compatibility-profile context
+  int gl_major = 0;
+  int gl_minor = 0;
+  int samples = 0;  // MSAA samples per pixel actually used (1: no multisampling)
+};
+
+// Owns one OSMesa context (created in the constructor, destroyed in the destructor). The
+// context is made current on the calling thread by the constructor and by every render(); a
+// Renderer must be used from one thread at a time. Framebuffers are allocated on the first
+// render() and reallocated when the frame size changes. Not copyable; movable (a moved-from
+// Renderer may only be destroyed or assigned to).
+class Renderer {
+ public:
+  // Frames up to max_width × max_height pixels can be rendered. `samples` is the requested
+  // MSAA sample count, capped at what the implementation supports (GL_MAX_SAMPLES).
+  // Throws std::invalid_argument for non-positive sizes and std::runtime_error if the OSMesa
+  // context, shaders or framebuffers cannot be set up.
+  explicit Renderer(int max_width = 1920, int max_height = 1080, int samples = 4);
+  ~Renderer();
+  Renderer(Renderer&&) noexcept;
+  Renderer& operator=(Renderer&&) noexcept;
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Draws the frame and returns its pixels (top row first). Throws std::invalid_argument for
+  // an inconsistent frame (sizes out of range, index out of bounds, degenerate camera) and
+  // std::runtime_error if GL reports an error.
+  Image render(const Frame& frame);
+
+  const RendererInfo& info() const;
+  int max_width() const;
+  int max_height() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clothsim::render
