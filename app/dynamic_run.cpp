@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cstdlib>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -266,6 +267,52 @@ class Outputs {
   StreamFile stats_;
 };
 
+// Progress on stderr: a bar redrawn in place on a terminal, plain lines every 10 % otherwise.
+class Progress {
+ public:
+  Progress(int steps, double fps) : steps_(steps), fps_(fps), terminal_(::isatty(2) != 0) {}
+  void update(int step, double t, int frames, double wall) {
+    const double done = static_cast<double>(step) / steps_;
+    const double eta = step > 0 ? wall * (1.0 / done - 1.0) : 0.0;
+    const int total_frames = static_cast<int>(std::floor(t / std::max(done, 1e-12) * fps_ + 1e-9)) + 1;
+    char text[160];
+    if (terminal_) {
+      const int width = 30, filled = static_cast<int>(done * width);
+      std::string bar(static_cast<std::size_t>(filled), '#');
+      bar.resize(width, ' ');
+      std::snprintf(text, sizeof(text), "\rclothsim: [%s] frame %d/%d  t = %.3f s  ETA %.0f s   ", bar.c_str(), frames,
+                    total_frames, t, eta);
+      std::cerr << text << (step == steps_ ? "\n" : "") << std::flush;
+      return;
+    }
+    if (step != steps_ && step % std::max(1, (steps_ + 9) / 10) != 0) return;
+    std::snprintf(text, sizeof(text), "step %d/%d (%d%%), frame %d, t = %.4g s, wall %.3g s, ETA %.3g s", step, steps_,
+                  static_cast<int>(100.0 * done), frames, t, wall, eta);
+    log_line(text);
+  }
+
+ private:
+  int steps_;
+  double fps_;
+  bool terminal_;
+};
+
+// DIR/<name>.mp4 from frame_%04d.png with ffmpeg, if it is installed (a warning otherwise).
+void encode_video(const fs::path& dir, const std::string& name, double fps) {
+  if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {
+    log_line("warning: --video: ffmpeg is not installed; no video written");
+    return;
+  }
+  char rate[32];
+  std::snprintf(rate, sizeof(rate), "%.6g", fps);
+  const std::string command = "ffmpeg -loglevel error -y -framerate " + std::string(rate) + " -i '" +
+                              (dir / "frame_%04d.png").string() +
+                              "' -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -crf 20 '" +
+                              (dir / (name + ".mp4")).string() + "'";
+  if (std::system(command.c_str()) != 0) throw std::runtime_error("ffmpeg failed: " + command);
+  log_line("wrote " + (dir / (name + ".mp4")).string());
+}
+
 void print_summary(const Scene& scene, const Simulator& sim, const RunTotals& totals, double wall_seconds,
                    const fs::path& dir) {
   std::ostringstream s;
@@ -291,7 +338,7 @@ void print_summary(const Scene& scene, const Simulator& sim, const RunTotals& to
 
 }  // namespace
 
-int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_frames) {
+int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_frames, bool video) {
   const std::string file = scene.file.string();
   const Clock::time_point start = Clock::now();
 
@@ -334,7 +381,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
     write_atomically(dir / "summary.json", summary_json(scene, totals, seconds_since(start), warnings, "running", ""));
     outputs = std::make_unique<Outputs>(scene, dir, drawer.get());
     outputs->record_state(*sim, 0, sim->state().t, totals);
-    const int progress_every = std::max(1, (steps + 9) / 10);
+    Progress progress(steps, scene.dynamic.time.output_fps);
     for (int k = 1; k <= steps; ++k) {
       try {
         const StepStats s = sim->step();
@@ -352,10 +399,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
         // Name the step for any other failure (write errors, solver exceptions), as SimulationError does.
         throw SimulationError(k, k * scene.dynamic.time.dt, e.what());
       }
-      if (k % progress_every == 0 || k == steps)
-        log_line("step " + std::to_string(k) + "/" + std::to_string(steps) + " (" +
-                 std::to_string(static_cast<long long>(100.0 * k / steps)) + "%), t = " + format_short(totals.t) +
-                 " s, wall " + format_short(seconds_since(start)) + " s");
+      progress.update(k, totals.t, totals.frames, seconds_since(start));
     }
   } catch (const std::exception& e) {
     failure = e.what();
@@ -367,6 +411,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
       const int images = outputs->render_frames(*renderer);
       log_line("rendered " + std::to_string(images) + " frame(s) of " + std::to_string(drawer->fine_triangles()) +
                " triangles to " + (dir / "frame_*.png").string());
+      if (video && images > 0) encode_video(dir, scene.name, scene.dynamic.time.output_fps);
     } catch (const std::exception& e) {
       if (failure.empty()) failure = std::string("rendering failed: ") + e.what();
       else log_line("warning: rendering failed: " + std::string(e.what()));

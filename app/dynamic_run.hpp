@@ -17,6 +17,7 @@ namespace clothsim {
 // "clothsim: error: <file>: step N (t = ... s): <message>" to stderr, keeps the files written
 // so far, records status "failed" in summary.json and returns 1. Log lines and progress go to
 // stderr, the summary to stdout.
-int run_dynamic_scene(const Scene& scene, const std::filesystem::path& out_root, bool render_frames = true);
+int run_dynamic_scene(const Scene& scene, const std::filesystem::path& out_root, bool render_frames = true,
+                      bool video = false);
 
 }  // namespace clothsim

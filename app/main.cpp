@@ -4,15 +4,46 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <iostream>
 #include <string>
 
+namespace {
+
+// `clothsim render DIR [--size WxH]`.
+int render_command(int argc, char** argv) {
+  CLI::App app{"clothsim render: draw the saved frames DIR/frames/mesh_*.obj of a dynamic run again into\n"
+               "DIR/frame_NNNN.png, without simulating.",
+               "clothsim render"};
+  std::string dir, size;
+  app.add_option("dir", dir, "Output folder of a run (with frames/mesh_*.obj)")->required()->type_name("DIR");
+  app.add_option("--size", size, "Image size, e.g. 960x720")->type_name("WxH");
+  try {
+    app.parse(argc - 1, argv + 1);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "clothsim: error: " << e.what() << "\nRun with --help for usage.\n";
+    return 1;
+  }
+  int width = 0, height = 0;
+  if (!size.empty() && (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 ||
+                        width > 8192 || height > 8192)) {
+    std::cerr << "clothsim: error: --size: expected WxH with 16 <= W, H <= 8192 (got \"" << size << "\")\n";
+    return 1;
+  }
+  return clothsim::render_saved_frames(dir, width, height);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "render") return render_command(argc, argv);
   CLI::App app{
       "clothsim: Kirchhoff-Love thin-shell cloth simulator on Loop-subdivision surfaces.\n"
       "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes\n"
       "its results to DIR/<scene name>/: result.json and limit.obj for a static scene;\n"
-      "probes.csv, stats.csv, summary.json and (with output.obj) frames/ for a dynamic one.",
+      "probes.csv, stats.csv, summary.json, frame_NNNN.png and (with output.obj) frames/ for a\n"
+      "dynamic one. `clothsim render DIR` draws a run's saved frames/mesh_*.obj again.",
       "clothsim"};
   std::string scene;
   std::string out = "out";
@@ -23,9 +54,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   CLI::Option* end_option =
       app.add_option("--end", end, "Dynamic scenes: simulate to time T [s] instead of time.end")->type_name("T");
-  bool no_render = false;
+  bool no_render = false, video = false;
   std::string size;
+  int frames = 0;
   app.add_flag("--no-render", no_render, "Write no PNG images");
+  app.add_flag("--video", video, "Also write DIR/<name>/<name>.mp4 (needs ffmpeg)");
+  CLI::Option* frames_option =
+      app.add_option("--frames", frames, "Dynamic scenes: simulate just long enough for N frames")->type_name("N");
   app.add_option("--size", size, "Image size, e.g. 960x720 (replaces render.width/height)")->type_name("WxH");
   try {
     app.parse(argc, argv);
@@ -37,6 +72,8 @@ int main(int argc, char** argv) {
   clothsim::RunOptions options;
   if (end_option->count() > 0) options.end = end;
   options.render = !no_render;
+  options.video = video;
+  if (frames_option->count() > 0) options.frames = frames;
   if (!size.empty()) {
     const auto x = size.find('x');
     try {

@@ -8,6 +8,7 @@
 #include "render/png_io.hpp"
 #include "render/renderer.hpp"
 #include "sim/mesh/obj_io.hpp"
+#include "sim/shell/ghost_layer.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/static/static_solve.hpp"
 
@@ -18,6 +19,8 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <algorithm>
+#include <memory>
 #include <fstream>
 #include <functional>
 #include <iomanip>
@@ -139,6 +142,13 @@ std::string shortest(double v) {
 
 // Applies --end to a dynamic scene; throws for a static scene or an invalid value.
 void apply_end_option(Scene& scene, const RunOptions& options) {
+  if (options.frames) {
+    if (scene.analysis != "dynamic") throw std::runtime_error("--frames: only applies to dynamic scenes");
+    if (*options.frames < 1) throw std::runtime_error("--frames: must be >= 1");
+    const double end = std::max(scene.dynamic.time.dt, (*options.frames - 1) / scene.dynamic.time.output_fps);
+    log_line("--frames " + std::to_string(*options.frames) + ": simulating to t = " + shortest(end) + " s");
+    scene.dynamic.time.end = end;
+  }
   if (!options.end) return;
   const double end = *options.end;
   if (scene.analysis != "dynamic")
@@ -165,7 +175,7 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     apply_end_option(scene, options);
     if (options.width > 0) scene.render.width = options.width;
     if (options.height > 0) scene.render.height = options.height;
-    if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root, options.render);
+    if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root, options.render, options.video);
 
     StaticResult result;
     try {
@@ -198,6 +208,54 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
       throw std::runtime_error("cannot write the results to " + (out_root / scene.name).string() + ": " + e.what());
     }
     print_summary(scene, result, out_root / scene.name);
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "clothsim: error: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+int render_saved_frames(const fs::path& dir, int width, int height) {
+  try {
+    std::vector<fs::path> files;
+    const fs::path frames = dir / "frames";
+    if (!fs::is_directory(frames))
+      throw std::runtime_error(frames.string() + ": no such folder (run the scene with \"output\": {\"obj\": true})");
+    for (const auto& entry : fs::directory_iterator(frames)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("mesh_", 0) == 0 && entry.path().extension() == ".obj") files.push_back(entry.path());
+    }
+    std::sort(files.begin(), files.end());
+    if (files.empty()) throw std::runtime_error(frames.string() + ": no mesh_*.obj frames");
+    // The saved meshes are limit points at the control connectivity; they are drawn as control
+    // meshes of their own subdivision surface (a slightly smoothed picture of the same surface).
+    RenderSettings settings;
+    if (width > 0) settings.width = width;
+    if (height > 0) settings.height = height;
+    std::unique_ptr<LimitSurfaceDrawer> drawer;
+    std::vector<SurfaceSnapshot> snapshots;
+    render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
+    std::vector<Triangle> first_triangles;
+    for (const fs::path& file : files) {
+      const TriMesh mesh = read_obj(file.string());
+      if (!drawer) {
+        first_triangles = mesh.triangles;
+        drawer = std::make_unique<LimitSurfaceDrawer>(build_ghost_layer(mesh), settings, settings.width, settings.height);
+      } else if (mesh.triangles != first_triangles) {
+        throw std::runtime_error(file.string() + ": its triangles differ from " + files.front().string());
+      }
+      snapshots.push_back(drawer->snapshot(build_ghost_layer(mesh).rest));
+      LimitSurfaceDrawer::extend_bounds(snapshots.back(), lo, hi);
+    }
+    render::Renderer renderer(settings.width, settings.height);
+    const render::Camera camera = drawer->camera(lo, hi);
+    for (std::size_t k = 0; k < snapshots.size(); ++k) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "frame_%04zu.png", k);
+      render::write_png((dir / name).string(), renderer.render(drawer->frame(snapshots[k], camera, lo[1])));
+    }
+    std::cout << "rendered " << snapshots.size() << " frame(s) from " << frames.string() << " to "
+              << (dir / "frame_*.png").string() << "\n";
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "clothsim: error: " << e.what() << '\n';

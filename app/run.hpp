@@ -12,7 +12,12 @@ struct RunOptions {
   std::optional<double> end;  // --end T [s]: replaces time.end of a dynamic scene
   bool render = true;         // --no-render turns PNG output off
   int width = 0, height = 0;  // --size WxH: replaces render.width/height (0: keep)
+  std::optional<int> frames;  // --frames N: simulate just long enough for N frames
+  bool video = false;         // --video: also encode DIR/<name>/<name>.mp4 with ffmpeg
 };
+
+// `clothsim render DIR`: draws DIR/frames/mesh_*.obj again into DIR/frame_NNNN.png.
+int render_saved_frames(const std::filesystem::path& dir, int width, int height);
 
 // Loads `scene_file`, runs its analysis and writes `out_root`/<scene name>/, replacing an older
 // folder of that name: result.json and limit.obj for a static scene; probes.csv, stats.csv,
