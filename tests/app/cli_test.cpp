@@ -1,6 +1,8 @@
 // The clothsim command: runs the built binary on scenes written to a fresh temporary folder and
 // checks exit codes, error messages, that invalid input leaves no output behind, and the streamed
 // outputs of dynamic runs (also when they fail part-way).
+#include "render/png_io.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -388,6 +390,51 @@ TEST_F(CliTest, DynamicRunFailureKeepsOutputs) {
   const std::vector<std::string> stats = lines_of(read_text(dir / "stats.csv"));
   ASSERT_EQ(stats.size(), 1u + static_cast<std::size_t>(steps));
   EXPECT_EQ(stats[0], "step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy");
+}
+
+TEST_F(CliTest, FramesOptionSizeAndNoRender) {
+  const fs::path scene = write("cloth.json", kFallingCloth);
+  // --frames 3 at 500 fps: t = 0, 2, 4 ms, one PNG each at the requested size.
+  RunResult r = run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --frames 3 --size 64x48");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int pngs = 0;
+  for (const auto& e : fs::directory_iterator(out_ / "cloth")) pngs += e.path().extension() == ".png";
+  EXPECT_EQ(pngs, 3);
+  const clothsim::render::Image image = clothsim::render::read_png((out_ / "cloth" / "frame_0002.png").string());
+  EXPECT_EQ(image.width, 64);
+  EXPECT_EQ(image.height, 48);
+  // --no-render: the same run writes no image.
+  r = run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --frames 3 --no-render");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const auto& e : fs::directory_iterator(out_ / "cloth")) EXPECT_NE(e.path().extension(), ".png") << e.path();
+  // A malformed size is an input error that writes nothing.
+  r = run(shell_quote(scene.string()) + " --out " + shell_quote((dir_ / "other").string()) + " --size 64by48");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(contains(r.err, "--size")) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "other"));
+}
+
+TEST_F(CliTest, RenderCommandRedrawsSavedFrames) {
+  const fs::path scene = write("cloth.json", kFallingCloth);
+  ASSERT_EQ(run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --no-render").exit_code, 0);
+  const fs::path run_dir = out_ / "cloth";
+  RunResult r = run("render " + shell_quote(run_dir.string()) + " --size 80x60");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int objs = 0, pngs = 0;
+  for (const auto& e : fs::directory_iterator(run_dir / "frames")) objs += e.path().extension() == ".obj";
+  for (const auto& e : fs::directory_iterator(run_dir)) pngs += e.path().extension() == ".png";
+  EXPECT_EQ(objs, 6);
+  EXPECT_EQ(pngs, objs);
+  const clothsim::render::Image image = clothsim::render::read_png((run_dir / "frame_0005.png").string());
+  EXPECT_EQ(image.width, 80);
+  // Not plain background: the (red) cloth is in the picture.
+  int coloured = 0;
+  for (std::size_t i = 0; i + 2 < image.rgb.size(); i += 3) coloured += image.rgb[i] > image.rgb[i + 1] + 40;
+  EXPECT_GT(coloured, 50);
+  // A folder without saved frames is an error naming it.
+  r = run("render " + shell_quote(dir_.string()));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_TRUE(contains(r.err, "frames")) << r.err;
 }
 
 }  // namespace
