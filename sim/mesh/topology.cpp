@@ -1,6 +1,7 @@
 #include "sim/mesh/topology.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <tuple>
 #include <string>
 
@@ -15,13 +16,11 @@ std::string tri_name(int t, const Triangle& tri) {
 
 Topology::Topology(int num_vertices, const std::vector<Triangle>& triangles)
     : rings_(num_vertices), boundary_(num_vertices, false), next_(num_vertices) {
-  // Directed edges (a, b, triangle), sorted: a repeated directed edge means two triangles
-  // traverse it the same way; more than two uses of an undirected edge is non-manifold.
-  struct Directed {
-    int a, b, t;
-  };
-  std::vector<Directed> directed;
-  directed.reserve(3 * triangles.size());
+  // Every triangle edge under the key (min, max), with its triangle and direction; one sort
+  // groups the uses of each undirected edge: more than two is non-manifold, two in the same
+  // direction is an inconsistent orientation.
+  std::vector<std::pair<std::uint64_t, std::int64_t>> uses;  // key, 2·triangle + (a > b)
+  uses.reserve(3 * triangles.size());
   for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
     const Triangle& tri = triangles[t];
     for (int k = 0; k < 3; ++k) {
@@ -30,30 +29,30 @@ Topology::Topology(int num_vertices, const std::vector<Triangle>& triangles)
         throw MeshError(tri_name(t, tri) + ": vertex index out of range (mesh has " +
                         std::to_string(num_vertices) + " vertices)");
       if (a == b || b == c || a == c) throw MeshError(tri_name(t, tri) + " is degenerate: repeated vertex");
-      directed.push_back({a, b, t});
+      const auto lo = static_cast<std::uint64_t>(std::min(a, b)), hi = static_cast<std::uint64_t>(std::max(a, b));
+      uses.emplace_back((lo << 32) | hi, 2 * static_cast<std::int64_t>(t) + (a > b ? 1 : 0));
       next_[a].emplace_back(b, c);
     }
   }
-  std::vector<Directed> undirected = directed;
-  for (Directed& d : undirected)
-    if (d.a > d.b) std::swap(d.a, d.b);
-  auto less = [](const Directed& x, const Directed& y) { return std::tie(x.a, x.b, x.t) < std::tie(y.a, y.b, y.t); };
-  std::sort(undirected.begin(), undirected.end(), less);
-  for (size_t i = 0; i + 2 < undirected.size(); ++i)
-    if (undirected[i].a == undirected[i + 2].a && undirected[i].b == undirected[i + 2].b) {
-      const int t = undirected[i + 2].t;
-      throw MeshError("non-manifold edge (" + std::to_string(undirected[i].a) + ", " +
-                      std::to_string(undirected[i].b) + "): shared by more than two triangles, e.g. " +
-                      tri_name(t, triangles[t]));
+  std::sort(uses.begin(), uses.end());
+  for (size_t i = 0; i < uses.size();) {
+    size_t j = i + 1;
+    while (j < uses.size() && uses[j].first == uses[i].first) ++j;
+    const int lo = static_cast<int>(uses[i].first >> 32), hi = static_cast<int>(uses[i].first & 0xffffffffu);
+    if (j - i > 2) {
+      const int t = static_cast<int>(uses[i + 2].second / 2);
+      throw MeshError("non-manifold edge (" + std::to_string(lo) + ", " + std::to_string(hi) +
+                      "): shared by more than two triangles, e.g. " + tri_name(t, triangles[t]));
     }
-  std::sort(directed.begin(), directed.end(), less);
-  for (size_t i = 0; i + 1 < directed.size(); ++i)
-    if (directed[i].a == directed[i + 1].a && directed[i].b == directed[i + 1].b) {
-      const int t0 = directed[i].t, t1 = directed[i + 1].t;
-      throw MeshError("inconsistent orientation at edge (" + std::to_string(directed[i].a) + ", " +
-                      std::to_string(directed[i].b) + "): " + tri_name(t0, triangles[t0]) + " and " +
+    if (j - i == 2 && uses[i].second % 2 == uses[i + 1].second % 2) {
+      const int t0 = static_cast<int>(uses[i].second / 2), t1 = static_cast<int>(uses[i + 1].second / 2);
+      const bool reversed = uses[i].second % 2 == 1;
+      throw MeshError("inconsistent orientation at edge (" + std::to_string(reversed ? hi : lo) + ", " +
+                      std::to_string(reversed ? lo : hi) + "): " + tri_name(t0, triangles[t0]) + " and " +
                       tri_name(t1, triangles[t1]) + " traverse it in the same direction");
     }
+    i = j;
+  }
   for (int v = 0; v < num_vertices; ++v) {
     auto& pairs = next_[v];
     if (pairs.empty()) throw MeshError("isolated vertex " + std::to_string(v) + ": it belongs to no triangle");
