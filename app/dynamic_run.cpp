@@ -4,6 +4,7 @@
 #include "app/dynamic_run.hpp"
 
 #include "app/limit_surface_drawer.hpp"
+#include "app/output_folders.hpp"
 #include "render/png_io.hpp"
 #include "render/renderer.hpp"
 
@@ -94,17 +95,6 @@ void write_atomically(const fs::path& path, const std::string& text) {
     if (!out) throw std::runtime_error(tmp.string() + ": cannot write the file");
   }
   fs::rename(tmp, path);
-}
-
-// The missing ancestors of `dir` (deepest first), i.e. the folders create_directories(dir) makes.
-std::vector<fs::path> missing_folders(const fs::path& dir) {
-  std::vector<fs::path> missing;
-  std::error_code ec;
-  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
-    missing.push_back(p);
-    if (p == p.parent_path()) break;
-  }
-  return missing;
 }
 
 // Creates a fresh, empty `root/<name>`. An older folder of that name is first renamed to

@@ -5,6 +5,7 @@
 
 #include "app/dynamic_run.hpp"
 #include "app/limit_surface_drawer.hpp"
+#include "app/output_folders.hpp"
 #include "render/png_io.hpp"
 #include "render/renderer.hpp"
 #include "sim/mesh/obj_io.hpp"
@@ -62,17 +63,6 @@ void write_text(const fs::path& path, const std::string& text) {
   out << text;
   out.close();
   if (!out) throw std::runtime_error(path.string() + ": cannot write file");
-}
-
-// The missing ancestors of `dir` (deepest first), i.e. the folders create_directories(dir) makes.
-std::vector<fs::path> missing_folders(const fs::path& dir) {
-  std::vector<fs::path> missing;
-  std::error_code ec;
-  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
-    missing.push_back(p);
-    if (p == p.parent_path()) break;
-  }
-  return missing;
 }
 
 // Runs `write(tmp)` on a fresh folder `root/.<name>.tmp-<pid>`, then renames it to `root/<name>`

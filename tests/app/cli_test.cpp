@@ -3,6 +3,8 @@
 // outputs of dynamic runs (also when they fail part-way).
 #include "render/png_io.hpp"
 
+#include "tests/support/process.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -25,18 +27,8 @@ struct RunResult {
   std::string err;  // stderr
 };
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+std::string read_text(const fs::path& path) { return clothsim::testing::read_file_bytes(path); }
+using clothsim::testing::shell_quote;
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 

@@ -5,6 +5,8 @@
 #include "render/image_compare.hpp"
 #include "render/png_io.hpp"
 
+#include "tests/support/process.hpp"
+
 #include <gtest/gtest.h>
 
 #include <stdlib.h>
@@ -89,18 +91,8 @@ const Manifest& manifest() {
   return m;
 }
 
-std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+std::string read_bytes(const fs::path& path) { return clothsim::testing::read_file_bytes(path); }
+using clothsim::testing::shell_quote;
 
 // A test name from a golden's file name: "sleeve_twist_t0.3.png" → "sleeve_twist_t0_3".
 std::string test_name(const Golden& g) {
