@@ -429,4 +429,15 @@ TEST_F(CliTest, RenderCommandRedrawsSavedFrames) {
   EXPECT_TRUE(contains(r.err, "frames")) << r.err;
 }
 
+TEST_F(CliTest, VideoOptionEncodesTheFramesWithFfmpeg) {
+  if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg is not installed";
+  const fs::path scene = write("cloth.json", kFallingCloth);
+  const RunResult r =
+      run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --frames 4 --size 65x49 --video");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const fs::path video = out_ / "cloth" / "cloth.mp4";
+  ASSERT_TRUE(fs::exists(video)) << r.err;
+  EXPECT_GT(fs::file_size(video), 500u);  // odd sizes are padded for x264
+}
+
 }  // namespace
