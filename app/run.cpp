@@ -109,7 +109,8 @@ void print_summary(const Scene& scene, const StaticResult& result, const fs::pat
     s << "  probe " << p.name << " (vertex " << p.vertex << "): displacement [" << u(p.vertex, 0) << ", "
       << u(p.vertex, 1) << ", " << u(p.vertex, 2) << "] m\n";
   }
-  s << "  wrote " << (dir / "result.json").string() << " and " << (dir / "limit.obj").string() << "\n";
+  s << "  wrote " << (dir / "result.json").string() << ", limit.obj"
+    << (std::filesystem::exists(dir / "limit.png") ? " and limit.png" : "") << "\n";
   std::cout << s.str() << std::flush;
 }
 
