@@ -42,6 +42,7 @@ struct SolverSettings {
   int newton_iterations = 1;  // linear solves per step; > 1 re-extracts rotations (accuracy studies)
   PreconditionerType preconditioner = PreconditionerType::block_jacobi;  // pcg
   int refresh_iterations = 20;  // cholesky preconditioner: refactor after a solve that needed more
+  bool tension_stiffening = true;  // membrane geometric stiffness in the matrix (corotation.hpp)
 };
 
 // Rigid initial velocity field v = velocity + angular_velocity × (X − center).

@@ -161,6 +161,7 @@ Simulator::Simulator(const DynamicProblem& problem) {
     const Eigen::Vector3d x = problem.mesh.vertices.row(v);
     m.state.v.row(v) = (problem.initial.velocity + problem.initial.angular_velocity.cross(x - problem.initial.center)).transpose();
   }
+  m.elements.set_geometric_stiffness(problem.solver.tension_stiffening);
   m.limit_rest = m.model.limit_points(m.model.extended().rest);
   m.elements.evaluate(m.consistent(flat(m.state.x)));
 }

@@ -596,7 +596,8 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   SolverSettings s;
   if (j == nullptr) return s;
   r.check_object(*j, "solver",
-                 {"type", "tolerance", "max_iterations", "newton_iterations", "preconditioner", "refresh_iterations"});
+                 {"type", "tolerance", "max_iterations", "newton_iterations", "preconditioner", "refresh_iterations",
+                  "tension_stiffening"});
   if (const Json* v = r.find(*j, "type"))
     s.type = r.choice(*v, "solver.type", {"pcg", "cholmod"}, "solver type") == "cholmod" ? LinearSolverType::cholmod
                                                                                       : LinearSolverType::pcg;
@@ -614,6 +615,7 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
                            : PreconditionerType::block_jacobi;
   if (const Json* v = r.find(*j, "refresh_iterations"))
     s.refresh_iterations = r.integer_at_least(*v, "solver.refresh_iterations", 1);
+  if (const Json* v = r.find(*j, "tension_stiffening")) s.tension_stiffening = r.boolean(*v, "solver.tension_stiffening");
   return s;
 }
 
