@@ -683,7 +683,7 @@ TEST_F(SceneLoader, ShippedSleeveScenes) {
                                              {"sleeve_twist", 494, 936, 0.001, 1.5, "rotate"},
                                              {"sleeve_compress", 494, 936, 0.001, 1.5, "translate"},
                                              {"sleeve_compress_2542", 2542, 4960, 0.01, 1.0, "translate"},
-                                             {"metal_compress", 494, 936, 0.001, 1.5, "translate"},
+                                             {"metal_compress", 2542, 4960, 0.005, 1.5, "translate"},
                                              {"fig8_thin", 780, 1500, 0.001, 1.5, "rotate"},
                                              {"fig8_thick", 780, 1500, 0.001, 1.5, "rotate"},
                                              {"fig8_thick_stiff", 780, 1500, 0.001, 1.5, "rotate"}}) {
