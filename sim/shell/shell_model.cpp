@@ -47,12 +47,20 @@ ShellElement make_element(const ExtendedMesh& ext, const DofMap& dofs, const Tri
   std::map<int, Eigen::Index> col;
   for (size_t i = 0; i < el.real.size(); ++i) col[el.real[i]] = static_cast<Eigen::Index>(i);
   const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size()), nr = static_cast<Eigen::Index>(el.real.size());
-  el.fold = Eigen::MatrixXd::Zero(3 * np, 3 * nr);
+  std::vector<Eigen::Triplet<double>> weights;
   for (Eigen::Index p = 0; p < np; ++p)
     for (int c = 0; c < 3; ++c)
-      for (const auto& [dof, w] : dofs.combination(el.patch[p], c)) el.fold(3 * p + c, 3 * col.at(dof / 3) + dof % 3) += w;
-  el.sparse_fold = el.fold.sparseView();
+      for (const auto& [dof, w] : dofs.combination(el.patch[p], c))
+        weights.emplace_back(3 * p + c, 3 * col.at(dof / 3) + dof % 3, w);
+  el.fold.resize(3 * np, 3 * nr);
+  el.fold.setFromTriplets(weights.begin(), weights.end());
   return el;
+}
+
+// Tᵀ K T: a patch-coordinate matrix folded onto the element's real DOFs.
+Eigen::MatrixXd fold_patch_matrix(const ShellElement& el, const Eigen::MatrixXd& k) {
+  const Eigen::MatrixXd kt = k * el.fold;
+  return el.fold.transpose() * kt;
 }
 
 Eigen::MatrixX3d patch_rows(const Eigen::MatrixX3d& x, const std::vector<int>& ids) {
@@ -157,7 +165,7 @@ Eigen::MatrixXd ShellModel::folded_element_stiffness(int e) const {
   const ShellElement& el = elements_[e];
   const ElementMatrix k = element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_);
   if (el.identity) return k;
-  return el.fold.transpose() * k * el.fold;
+  return fold_patch_matrix(el, k);
 }
 
 Eigen::SparseMatrix<double> ShellModel::stiffness() const {
@@ -203,8 +211,7 @@ void ShellModel::add_patch_matrix(int e, const Eigen::MatrixXd& k_patch, Eigen::
     scatter_matrix(e, k_patch, global.valuePtr());
     return;
   }
-  const Eigen::MatrixXd kt = k_patch * el.sparse_fold;
-  scatter_matrix(e, Eigen::MatrixXd(el.sparse_fold.transpose() * kt), global.valuePtr());
+  scatter_matrix(e, fold_patch_matrix(el, k_patch), global.valuePtr());
 }
 
 void ShellModel::restrict_to_free(Eigen::SparseMatrix<double>& k) const {

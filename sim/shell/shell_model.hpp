@@ -33,8 +33,8 @@ struct ShellElement {
   std::vector<double> weights;      // quadrature weights (sum 1/2)
   std::vector<int> real;            // real vertices the patch's displacements depend on
   bool identity = false;            // patch == real and every component free and itself
-  Eigen::MatrixXd fold;             // 3·#patch × 3·#real weights (when !identity)
-  Eigen::SparseMatrix<double> sparse_fold;  // the same, sparse (most rows are unit rows)
+  Eigen::SparseMatrix<double> fold;  // 3·#patch × 3·#real weights (when !identity; most rows
+                                     // are unit rows)
 };
 
 class ShellModel {
