@@ -6,6 +6,7 @@ packages=(
   cmake g++ make pkg-config ninja-build
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libpng-dev libosmesa6-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev
+  python3-minimal python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -258,6 +258,8 @@ class Reader {
   std::string file_;
 };
 
+Json parse_text(const Reader& r, const std::string& text);
+
 Json parse_file(const Reader& r, const std::filesystem::path& file) {
   std::error_code ec;
   if (std::filesystem::is_directory(file, ec)) r.fail("", "is a directory, not a scene file");
@@ -269,11 +271,14 @@ Json parse_file(const Reader& r, const std::filesystem::path& file) {
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) r.fail("", "cannot read the scene file");
+  return parse_text(r, text.str());
+}
 
+Json parse_text(const Reader& r, const std::string& text) {
   DuplicateKeyFinder duplicates;
   Json j;
   try {
-    j = Json::parse(text.str(), [&duplicates](int, nlohmann::json::parse_event_t event, Json& parsed) {
+    j = Json::parse(text, [&duplicates](int, nlohmann::json::parse_event_t event, Json& parsed) {
       return duplicates.on_event(event, parsed);
     });
   } catch (const nlohmann::json::exception& e) {
@@ -727,10 +732,23 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   return s;
 }
 
+namespace {
+Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::path& file, const LogFn& log);
+}  // namespace
+
 Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
-  const LogFn say = log ? log : LogFn([](const std::string&) {});
   const Reader r(file.string());
-  const Json root = parse_file(r, file);
+  return load_scene_json(parse_file(r, file), r, file, log);
+}
+
+Scene load_scene_text(const std::string& text, const std::filesystem::path& file, const LogFn& log) {
+  const Reader r(file.string());
+  return load_scene_json(parse_text(r, text), r, file, log);
+}
+
+namespace {
+Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::path& file, const LogFn& log) {
+  const LogFn say = log ? log : LogFn([](const std::string&) {});
   r.check_object(root, "",
                  {"name", "description", "analysis", "mesh", "material", "boundary", "loads", "probes",
                   "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render"});
@@ -799,5 +817,6 @@ Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
   }
   return scene;
 }
+}  // namespace
 
 }  // namespace clothsim

@@ -65,6 +65,9 @@ struct Scene {
 // file's folder. Log lines (mesh preparation, selection sizes) go to `log`, which may be empty.
 // Throws SceneError.
 Scene load_scene(const std::filesystem::path& file, const LogFn& log);
+// The same for a scene given as JSON text (a study's variant of a scene file): `file` names the
+// scene in error messages, and relative OBJ paths are resolved against its folder.
+Scene load_scene_text(const std::string& text, const std::filesystem::path& file, const LogFn& log);
 
 // Index of the row of `vertices` [m] nearest to `point` [m] (Euclidean; ties → lowest index),
 // or -1 if there are no vertices.

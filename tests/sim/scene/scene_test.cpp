@@ -750,3 +750,25 @@ TEST_F(SceneLoader, ShippedSleeveScenes) {
 
 }  // namespace
 }  // namespace clothsim
+
+namespace clothsim {
+namespace {
+
+// A scene given as text (a study's variant of a scene file) is read like the file and errors
+// name the nominal file.
+TEST(SceneText, SameAsFileAndErrorsNameTheNominalFile) {
+  const std::string text = std::string("{\"name\": \"t\", ") + kGrid4 + "}";
+  const Scene s = load_scene_text(text, "scenes/variant.json", nullptr);
+  EXPECT_EQ(s.name, "t");
+  EXPECT_EQ(s.problem.mesh.num_vertices(), 25);
+  try {
+    load_scene_text(std::string("{\"nmae\": 1, ") + kGrid4 + "}", "scenes/variant.json", nullptr);
+    FAIL() << "an unknown key was accepted";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("scenes/variant.json: nmae"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(load_scene_text("{\"mesh\": ", "scenes/variant.json", nullptr), SceneError);
+}
+
+}  // namespace
+}  // namespace clothsim
