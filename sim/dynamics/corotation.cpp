@@ -4,6 +4,7 @@
 #include "sim/subdivision/box_spline.hpp"
 #include "sim/subdivision/patch.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -185,6 +186,33 @@ Eigen::SparseMatrix<double> CorotationalElements::assemble_stiffness() const {
       }
     });
   return k;
+}
+
+Eigen::MatrixX2d CorotationalElements::membrane_principal_strains(const Eigen::VectorXd& u) const {
+  const size_t count = stiffness_.size();
+  Eigen::MatrixX2d out(static_cast<Eigen::Index>(count), 2);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 64), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t e = range.begin(); e != range.end(); ++e) {
+      const Eigen::VectorXd x = rest_patch_[e] + model_.patch_vector(static_cast<int>(e), u);
+      Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
+      for (Eigen::Index p = 0; p < x.size() / 3; ++p) {
+        a1 += tangent_rows_[e](0, p) * x.segment<3>(3 * p);
+        a2 += tangent_rows_[e](1, p) * x.segment<3>(3 * p);
+      }
+      Eigen::Matrix2d g, rest;
+      g << a1.dot(a1), a1.dot(a2), a1.dot(a2), a2.dot(a2);
+      rest << rest_a1_[e].dot(rest_a1_[e]), rest_a1_[e].dot(rest_a2_[e]), rest_a1_[e].dot(rest_a2_[e]),
+          rest_a2_[e].dot(rest_a2_[e]);
+      // Eigenvalues of G⁻¹E: the symmetric problem L⁻¹ E L⁻ᵀ with G = L Lᵀ.
+      const Eigen::Matrix2d l = rest.llt().matrixL();
+      const Eigen::Matrix2d l_inv = l.inverse();
+      const Eigen::Matrix2d strain = 0.5 * l_inv * (g - rest) * l_inv.transpose();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(0.5 * (strain + strain.transpose()),
+                                                               Eigen::EigenvaluesOnly);
+      out.row(static_cast<Eigen::Index>(e)) = eig.eigenvalues().transpose();
+    }
+  });
+  return out;
 }
 
 double CorotationalElements::element_energy(int e, const Eigen::Matrix3d& r, const Eigen::VectorXd& x_patch) const {

@@ -52,6 +52,13 @@ class CorotationalElements {
   double element_energy(int e, const Eigen::Matrix3d& r, const Eigen::VectorXd& x_patch) const;
   Eigen::VectorXd element_force(int e, const Eigen::Matrix3d& r, const Eigen::VectorXd& x_patch) const;
 
+  // Principal Green–Lagrange membrane strains of the limit surface at each element's barycentre
+  // for real displacements u (3·#V, tied components consistent): the eigenvalues of G⁻¹ E with
+  // E = ½ (g − G), g_αβ = a_α·a_β and G_αβ = A_α·A_β from the current and rest limit tangents.
+  // #elements × 2, ascending per row [-]. A uniform stretch by λ gives ½(λ² − 1); any rigid
+  // motion gives 0. Computed on demand (a pass over the elements), not by evaluate().
+  Eigen::MatrixX2d membrane_principal_strains(const Eigen::VectorXd& u) const;
+
   // Include the tension-stiffening term (default true).
   void set_geometric_stiffness(bool on) { geometric_ = on; }
 

@@ -76,26 +76,39 @@ struct StepStats {
   double t = 0.0;                // time at the end of the step [s]
   int solver_iterations = 0;     // pcg iterations summed over Newton iterations (1 per direct solve)
   double residual = 0.0;         // final relative residual of the linear system
+  double newton_change = 0.0;    // ‖v⁺_k − v⁺_{k−1}‖ / ‖v⁺_k‖ of the last Newton iteration (0 with one)
   double rotate_ms = 0.0;        // rotation extraction
   double assemble_ms = 0.0;      // rotated stiffness, forces, system matrix
   double solve_ms = 0.0;         // linear solve
   double kinetic_energy = 0.0;   // ½ vᵀ M v [J]
   double elastic_energy = 0.0;   // corotated strain energy [J]
+  double external_work = 0.0;    // work of the external loads on the free components this step [J]
+  double boundary_work = 0.0;    // work of the scripted and held components on the cloth this step
+                                 // [J] (Simulator::boundary_work)
 };
 
 // A run that cannot go on: NaN, divergence or a linear solver that does not converge.
 class SimulationError : public std::runtime_error {
  public:
-  SimulationError(int step, double t, const std::string& what)
+  enum class Kind {
+    other,     // anything else (e.g. a follower couple that lost its lever arm)
+    nan,       // the state became NaN or infinite
+    diverged,  // a vertex moved more than 1000 times the mesh size
+    solver,    // the linear solver did not converge or the matrix was not positive definite
+  };
+  SimulationError(int step, double t, const std::string& what, Kind kind = Kind::other)
       : std::runtime_error("step " + std::to_string(step) + " (t = " + std::to_string(t) + " s): " + what),
         step_(step),
-        t_(t) {}
+        t_(t),
+        kind_(kind) {}
   int step() const { return step_; }
   double time() const { return t_; }
+  Kind kind() const { return kind_; }
 
  private:
   int step_;
   double t_;
+  Kind kind_;
 };
 
 }  // namespace clothsim

@@ -79,7 +79,8 @@ struct Simulator::Impl {
   bool have_factor = false;  // `direct` holds a factor usable as PCG preconditioner
   DynamicState state;
   Eigen::MatrixX3d limit_rest;
-  double work = 0.0;
+  double work = 0.0;           // external_work()
+  double boundary_work = 0.0;  // boundary_work()
   double bbox = 1.0;
 
   explicit Impl(const DynamicProblem& p)
@@ -180,6 +181,11 @@ double Simulator::kinetic_energy() const {
 }
 double Simulator::elastic_energy() const { return impl_->elements.energy(); }
 double Simulator::external_work() const { return impl_->work; }
+double Simulator::boundary_work() const { return impl_->boundary_work; }
+double Simulator::max_membrane_strain() const {
+  const Eigen::MatrixX2d strains = impl_->elements.membrane_principal_strains(impl_->consistent(flat(impl_->state.x)));
+  return strains.size() > 0 ? strains.cwiseAbs().maxCoeff() : 0.0;
+}
 const Eigen::VectorXd& Simulator::vertex_mass() const { return impl_->mass_per_vertex; }
 
 const ExtendedMesh& Simulator::extended_mesh() const { return impl_->model.extended(); }
@@ -233,6 +239,10 @@ StepStats Simulator::step() {
                               "moment " + std::to_string(i) + ": its vertices have come to lie on a line parallel to the moment");
     f_ext *= ramp;
   };
+  // The prescribed rows of the last solve's system (A's columns, by symmetry) and right-hand side,
+  // kept before the Dirichlet form: (A v⁺ − b)_p is the support's impulse (boundary_work()).
+  std::vector<std::vector<std::pair<Eigen::Index, double>>> prescribed_rows(m.prescribed_dof.size());
+  Eigen::VectorXd prescribed_rhs(static_cast<Eigen::Index>(m.prescribed_dof.size()));
   for (int k = 0; k < p.solver.newton_iterations; ++k) {
     auto t0 = std::chrono::steady_clock::now();
     external_force(x + h * v_k);
@@ -247,6 +257,12 @@ StepStats Simulator::step() {
     if (k > 0) b += h * h * (a * v_k);
     a *= c_stiff;
     for (Eigen::Index i = 0; i < 3 * m.n; ++i) a.coeffRef(i, i) += c_mass * m.mass(i);
+    for (size_t i = 0; i < m.prescribed_dof.size(); ++i) {
+      const int dof = m.prescribed_dof[i];
+      prescribed_rows[i].clear();
+      for (Eigen::SparseMatrix<double>::InnerIterator it(a, dof); it; ++it) prescribed_rows[i].emplace_back(it.row(), it.value());
+      prescribed_rhs(static_cast<Eigen::Index>(i)) = b(dof);
+    }
     stats.assemble_ms += ms_since(t0);
 
     t0 = std::chrono::steady_clock::now();
@@ -292,17 +308,19 @@ StepStats Simulator::step() {
         s << "the conjugate gradient solver did not converge: relative residual " << r.residual << " after "
           << r.iterations << " iterations (tolerance " << p.solver.tolerance
           << "); try a smaller time step, more iterations or \"solver\": {\"type\": \"cholmod\"}";
-        throw SimulationError(step_number, t_next, s.str());
+        throw SimulationError(step_number, t_next, s.str(), SimulationError::Kind::solver);
       }
     } else {
       dirichlet(a, &b);
       if (!m.direct.refactorize(a))
-        throw SimulationError(step_number, t_next, "the system matrix is not positive definite (CHOLMOD)");
+        throw SimulationError(step_number, t_next, "the system matrix is not positive definite (CHOLMOD)",
+                              SimulationError::Kind::solver);
       v_next = m.direct.solve(b);
       stats.solver_iterations += 1;
       stats.residual = (a * v_next - b).norm() / std::max(b.norm(), 1e-300);
     }
     stats.solve_ms += ms_since(t0);
+    if (k > 0) stats.newton_change = (v_next - v_k).norm() / std::max(v_next.norm(), 1e-300);
     v_k = v_next;
   }
 
@@ -313,9 +331,11 @@ StepStats Simulator::step() {
   x_next = m.rest + u_next;
   for (int dof : m.dependent_dof) v_next(dof) = (x_next(dof) - x(dof)) / h;
   if (!x_next.allFinite() || !v_next.allFinite())
-    throw SimulationError(step_number, t_next, "the state became NaN or infinite (numerical instability)");
+    throw SimulationError(step_number, t_next, "the state became NaN or infinite (numerical instability)",
+                          SimulationError::Kind::nan);
   if ((x_next - m.rest).cwiseAbs().maxCoeff() > 1e3 * m.bbox)
-    throw SimulationError(step_number, t_next, "the simulation diverged (a vertex moved more than 1000 times the mesh size)");
+    throw SimulationError(step_number, t_next, "the simulation diverged (a vertex moved more than 1000 times the mesh size)",
+                          SimulationError::Kind::diverged);
 
   // Forces and energy at the new state (reused by the next step's linearisation).
   m.elements.evaluate(u_next);
@@ -323,7 +343,17 @@ StepStats Simulator::step() {
   stats.assemble_ms += m.elements.last_force_ms();
 
   for (Eigen::Index i = 0; i < 3 * m.n; ++i)
-    if (m.solve_free[i]) m.work += f_ext(i) * (x_next(i) - x(i));
+    if (m.solve_free[i]) stats.external_work += f_ext(i) * (x_next(i) - x(i));
+  // Work of the supports (and of the loads on the supported components): (R_p + f_ext,p) Δx_p
+  // with h R_p = (A v⁺ − b)_p and Δx_p = h v⁺_p.
+  for (size_t i = 0; i < m.prescribed_dof.size(); ++i) {
+    const int dof = m.prescribed_dof[i];
+    double impulse = -prescribed_rhs(static_cast<Eigen::Index>(i));
+    for (const auto& [row, value] : prescribed_rows[i]) impulse += value * v_next(row);
+    stats.boundary_work += (impulse + h * f_ext(dof)) * v_next(dof);
+  }
+  m.work += stats.external_work;
+  m.boundary_work += stats.boundary_work;
   m.state.x = unflat(x_next);
   m.state.v = unflat(v_next);
   m.state.t = t_next;

@@ -60,12 +60,31 @@ class Simulator {
   const ExtendedMesh& extended_mesh() const;
   Eigen::MatrixX3d extended_positions() const;
 
-  // Energy bookkeeping [J]: ½ vᵀ M v; the corotated strain energy of the current state; and
-  // the work done so far by the external loads (gravity, surface loads, point loads; not by
-  // scripted supports), Σ f_extᵀ (x⁺ − x).
+  // Energy bookkeeping [J]: ½ vᵀ M v; the corotated strain energy of the current state; the
+  // work done so far by the external loads (gravity, surface loads, point loads, couples) on the
+  // free components, Σ f_extᵀ (x⁺ − x); and the work done so far on the cloth by the scripted
+  // and held components (see below). Over a run, with E = kinetic + elastic energy,
+  //     E(t) − E(0) = external_work + boundary_work − dissipated,
+  // where `dissipated` >= 0 for a linear (non-rotating) system: Kelvin–Voigt and mass damping,
+  // and implicit Euler's own ½|Δv|²_M + ½ Δxᵀ K Δx per step. A rise beyond the two works comes
+  // from the nonlinearity of the corotation (rotations frozen over a step) or a bug.
+  //
+  // Boundary work. A prescribed component p is moved by Δx_p = h v⁺_p; the force the support
+  // exerts on it is the reaction that makes its row of the step's system hold,
+  //     h R_p = (A v⁺ − b)_p,   A = (1 + h c_M) M + (h c_K + h²) K_R,  b = M v + h (f_int + f_ext),
+  // i.e. R_p = M (v⁺ − v)/h − [f_int − h K_R v⁺ − D v⁺]_p − f_ext,p: inertia minus the cloth's
+  // (linearised end-of-step, damped) internal force and the load on that component. The work of
+  // the support and of the load on the component, (R_p + f_ext,p) Δx_p, is summed. Using the
+  // integrator's own force (not a quadrature of f_int over the step) makes the balance above
+  // exact, step by step, for a linear system: a rise then measures the corotation's error alone.
   double kinetic_energy() const;
   double elastic_energy() const;
   double external_work() const;
+  double boundary_work() const;
+  // Largest |principal Green–Lagrange membrane strain| of the limit surface at the element
+  // barycentres in the current state [-] (CorotationalElements::membrane_principal_strains);
+  // computed on demand, a pass over the elements.
+  double max_membrane_strain() const;
   // Lumped mass per control vertex [kg] (areal density × a third of the incident area).
   const Eigen::VectorXd& vertex_mass() const;
 
