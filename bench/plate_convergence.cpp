@@ -3,7 +3,7 @@
 // Woinowsky-Krieger): hinged or clamped edges, uniform load q = 1 N/m² or a centre point load
 // P = 1 N, one- and three-point quadrature, grids 8² … 64² (--max 128 adds 128²).
 // Prints a Markdown table to stdout; --csv FILE also writes the rows as CSV.
-#include "tests/support/plates.hpp"
+#include "sim/study/plates.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -18,24 +18,9 @@
 namespace clothsim {
 namespace {
 
-struct PlateCase {
-  const char* name;
-  bool clamped;
-  bool point_load;
-  double coefficient;  // w = c q a⁴ / D (uniform load) or w = c P a² / D (point load)
-};
-
-constexpr PlateCase kCases[] = {
-    {"simply supported, uniform load", false, false, 0.00406235},
-    {"clamped, uniform load", true, false, 0.00126532},
-    {"simply supported, centre point load", false, true, 0.0116008},
-    {"clamped, centre point load", true, true, 0.005612},
-};
 constexpr Quadrature kRules[] = {Quadrature::one_point, Quadrature::three_point};
 
-constexpr double kSide = 1.0;   // a [m]
-constexpr double kPressure = 1.0;  // q [N/m²]
-constexpr double kForce = 1.0;     // P [N]
+constexpr double kSide = 1.0;  // a [m]
 
 struct Row {
   std::string case_name, quadrature, mesh;
@@ -85,25 +70,19 @@ std::string format(const char* fmt, double x) {
   return buf;
 }
 
-Row run(const PlateCase& c, Quadrature rule, int divisions) {
-  StaticProblem p = testing::square_plate(divisions, c.clamped, rule, kSide);
-  const int centre = testing::nearest_vertex(p.mesh, Eigen::Vector3d::Zero());
-  if (c.point_load)
-    p.point_loads.push_back({centre, Eigen::Vector3d(0.0, 0.0, -kForce)});
-  else
-    p.surface_load = Eigen::Vector3d(0.0, 0.0, -kPressure);
+Row run(const AnalyticPlate& c, Quadrature rule, int divisions) {
+  const StaticProblem p = plate_problem(c, divisions, rule, kSide);
+  const int centre = nearest_vertex(p.mesh, Eigen::Vector3d::Zero());
   const StaticResult r = solve_static(p);
 
-  const double d = testing::plate_rigidity(p);
   Row row;
-  row.case_name = c.name;
+  row.case_name = c.label;
   row.quadrature = to_string(rule);
   row.mesh = std::to_string(divisions) + "×" + std::to_string(divisions);
   row.vertices = p.mesh.num_vertices();
   row.dofs = r.dofs;
   row.deflection = -r.limit_displacement(centre, 2);  // downward deflection, positive [m]
-  row.reference = c.point_load ? c.coefficient * kForce * kSide * kSide / d
-                               : c.coefficient * kPressure * std::pow(kSide, 4) / d;
+  row.reference = plate_reference_deflection(c, p, kSide);
   row.error_percent = 100.0 * (row.deflection - row.reference) / row.reference;
   row.assemble_seconds = r.assemble_seconds;
   row.solve_seconds = r.solve_seconds;
@@ -140,7 +119,7 @@ int main_impl(int argc, char** argv) {
   std::cout << "| case | quadrature | mesh | vertices | dofs | centre deflection [m] | reference [m] | error % "
                "| observed order | assemble s | solve s |\n"
             << "|---|---|---|--:|--:|--:|--:|--:|--:|--:|--:|\n";
-  for (const PlateCase& c : kCases) {
+  for (const AnalyticPlate& c : kAnalyticPlates) {
     for (const Quadrature rule : kRules) {
       std::optional<double> previous_error;
       for (int n = 8; n <= opt.max_divisions; n *= 2) {

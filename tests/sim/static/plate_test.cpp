@@ -11,24 +11,17 @@
 namespace clothsim {
 namespace {
 
-enum class Load { uniform, point };
-
-struct PlateCase {
-  bool clamped;
-  Load load;
-  double coefficient;  // w = coefficient · q a⁴ / D (uniform) or · P a² / D (point), a = 1
-};
-
-const PlateCase kSimplySupportedUniform{false, Load::uniform, 0.00406235};
-const PlateCase kClampedUniform{true, Load::uniform, 0.00126532};
-const PlateCase kSimplySupportedPoint{false, Load::point, 0.0116008};
-const PlateCase kClampedPoint{true, Load::point, 0.005612};
+using PlateCase = AnalyticPlate;  // the coefficients live in sim/study/plates.hpp
+const PlateCase& kSimplySupportedUniform = kAnalyticPlates[0];
+const PlateCase& kClampedUniform = kAnalyticPlates[1];
+const PlateCase& kSimplySupportedPoint = kAnalyticPlates[2];
+const PlateCase& kClampedPoint = kAnalyticPlates[3];
 
 // Relative error of the centre deflection (limit surface at the centre vertex).
 double centre_error(const PlateCase& c, int divisions, Quadrature rule, StaticResult* out = nullptr) {
   StaticProblem p = testing::square_plate(divisions, c.clamped, rule);
   const int centre = testing::nearest_vertex(p.mesh, Eigen::Vector3d::Zero());
-  if (c.load == Load::uniform)
+  if (!c.point_load)
     p.surface_load = Eigen::Vector3d(0, 0, -1.0);
   else
     p.point_loads = {{centre, Eigen::Vector3d(0, 0, -1.0)}};
@@ -52,8 +45,7 @@ TEST(AnalyticPlates, ErrorFallsUnderRefinementAtSecondOrder) {
     double previous = 0.0;
     for (int n : {8, 16, 32, 64}) {
       const double err = std::abs(centre_error(c, n, Quadrature::one_point));
-      std::printf("clamped=%d load=%s n=%d error=%.4f%%\n", c.clamped, c.load == Load::uniform ? "uniform" : "point", n,
-                  100 * err);
+      std::printf("%s n=%d error=%.4f%%\n", c.id, n, 100 * err);
       if (n > 8) {
         EXPECT_LT(err, previous) << "n = " << n;
         // Each halving of the element size should cut the error by about 4 (O(h²)).

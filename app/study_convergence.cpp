@@ -1,0 +1,101 @@
+// `clothsim study convergence [--out DIR] [--quick] [--no-plot]`: runs the convergence study
+// (sim/study/convergence.hpp, docs/convergence.md) and writes DIR/study_convergence/:
+//   results.csv        one row per run (columns: results_csv_columns())
+//   results.md         the same rows as a Markdown table
+//   error_vs_time.png  log–log error against wall time (scripts/plot_convergence.py, matplotlib)
+// The folder is built as DIR/.study_convergence.tmp-<pid> and renamed into place at the end; an
+// older report is replaced only then. If only the plot fails, the folder (with the CSV) is still
+// published and the command exits with 1.
+#include "app/output_folders.hpp"
+#include "app/plotting.hpp"
+#include "app/study.hpp"
+#include "sim/study/convergence.hpp"
+#include "sim/study/report_format.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+
+#ifndef CLOTHSIM_SOURCE_DIR
+#error "CLOTHSIM_SOURCE_DIR must be defined (app/CMakeLists.txt)"
+#endif
+
+namespace clothsim {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+void write_text_file(const fs::path& path, const std::string& what, void (*write)(std::ostream&, const std::vector<ConvergenceRow>&),
+                     const std::vector<ConvergenceRow>& rows) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw std::runtime_error("cannot write " + path.string() + " (" + what + ")");
+  write(out, rows);
+  out.flush();
+  if (!out) throw std::runtime_error("writing " + path.string() + " failed");
+}
+
+// Moves `staging` to `target`, replacing an older `target` only once the new one is in place.
+void publish(const fs::path& staging, const fs::path& target) {
+  const fs::path old = target.parent_path() / (".study_convergence.old-" + std::to_string(::getpid()));
+  const bool had_old = fs::exists(target);
+  if (had_old) fs::rename(target, old);
+  try {
+    fs::rename(staging, target);
+  } catch (...) {
+    if (had_old) fs::rename(old, target);
+    throw;
+  }
+  if (had_old) fs::remove_all(old);
+}
+
+}  // namespace
+
+int run_convergence_study(const StudyOptions& options) {
+  const fs::path target = options.out_root / "study_convergence";
+  const fs::path staging = options.out_root / (".study_convergence.tmp-" + std::to_string(::getpid()));
+  std::vector<fs::path> created;
+  try {
+    const auto start = std::chrono::steady_clock::now();
+    const fs::path scenes = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
+    const ConvergencePlan plan = options.quick ? quick_convergence_plan(scenes) : full_convergence_plan(scenes);
+    const std::vector<ConvergenceRow> rows = run_convergence(plan, convergence_methods(), [](const std::string& line) {
+      std::cerr << "clothsim: convergence: " << line << std::endl;
+    });
+
+    created = missing_folders(options.out_root);
+    fs::create_directories(options.out_root);
+    fs::remove_all(staging);
+    fs::create_directory(staging);
+    const fs::path csv = staging / "results.csv";
+    write_text_file(csv, "results table", write_results_csv, rows);
+    write_text_file(staging / "results.md", "Markdown table", write_results_markdown, rows);
+
+    std::string plot_error;
+    if (options.plot)
+      plot_error = run_plot_script("plot_convergence.py", {csv.string(), (staging / "error_vs_time.png").string()});
+    publish(staging, target);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "convergence study: " << rows.size() << " rows in " << format_fixed(seconds, 1) << " s; wrote "
+              << (target / "results.csv").string() << (options.plot && plot_error.empty() ? " and error_vs_time.png" : "")
+              << '\n';
+    if (!plot_error.empty()) {
+      std::cerr << "clothsim: error: error_vs_time.png: " << plot_error << " (results.csv was written to "
+                << target.string() << ")\n";
+      return 1;
+    }
+    return 0;
+  } catch (const std::exception& e) {
+    std::error_code ec;
+    fs::remove_all(staging, ec);
+    for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if still empty
+    std::cerr << "clothsim: error: convergence study: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace clothsim

@@ -1,0 +1,175 @@
+#!/usr/bin/python3
+"""Draws the convergence study's plot: relative error against wall time, log-log.
+
+Usage: plot_convergence.py RESULTS.csv OUTPUT.png
+
+Reads the results.csv written by `clothsim study convergence` (columns documented in
+docs/convergence.md) and draws one panel for the static plates and one per dynamic case. Colour
+= method (the same in every panel, so later baseline methods are new colours), marker and line
+style = plate case (plates panel) or series and error window (dynamic panels: solid = mesh
+refinement at a fixed time step, dashed = time-step refinement on the reference mesh, both with
+filled markers for the first window; dotted and dash-dotted with hollow markers for later
+windows). Plates: thin grey lines mark the relative precision of each published coefficient.
+Rows of the "reference" series, failed runs (error nan) and errors of exactly 0 cannot be drawn
+on a log axis and are left out. Exits with status 3 when matplotlib is missing (Debian:
+python3-matplotlib).
+"""
+
+import csv
+import math
+import sys
+
+try:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+except ImportError:
+    sys.stderr.write("plot_convergence.py: matplotlib is not installed (Debian: python3-matplotlib)\n")
+    sys.exit(3)
+
+PLATES = "plates"
+PLATE_STYLES = {  # case -> (marker, line style)
+    "plate_ss_uniform": ("o", "-"),
+    "plate_clamped_uniform": ("s", "--"),
+    "plate_ss_point": ("^", "-."),
+    "plate_clamped_point": ("D", ":"),
+}
+SERIES_STYLES = {"mesh": ("o", "-"), "dt": ("s", "--")}  # first window (filled markers)
+LATER_WINDOW_STYLES = {"mesh": ("o", ":"), "dt": ("s", "-.")}  # later windows (hollow markers)
+SERIES_LABELS = {"mesh": "mesh series", "dt": "time-step series"}
+
+
+def read_rows(path):
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.DictReader(f))
+    required = {"case", "method", "series", "setting", "wall_seconds", "error"}
+    if rows and not required <= set(rows[0]):
+        raise SystemExit(f"plot_convergence.py: {path}: missing columns {sorted(required - set(rows[0]))}")
+    return rows
+
+
+def drawable(row):
+    try:
+        error, seconds = float(row["error"]), float(row["wall_seconds"])
+    except ValueError:
+        return False
+    return row["series"] != "reference" and math.isfinite(error) and error > 0 and seconds > 0
+
+
+def panel_of(case):
+    return PLATES if case.startswith("plate_") else case
+
+
+def short_setting(row):
+    """The part of the setting that changes along the curve: '26x19' or 'dt=0.002'."""
+    parts = row["setting"].split(" ")
+    return parts[-1] if row["series"] == "dt" and len(parts) > 1 else parts[0]
+
+
+def draw_reference_precision(ax, rows):
+    """Thin grey lines at the relative precision of each plate's published coefficient, for the
+    coefficients whose precision comes near the smallest plotted error."""
+    precision, smallest = {}, {}
+    for row in rows:
+        if not row["case"].startswith("plate_"):
+            continue
+        try:
+            value = float(row.get("reference_precision") or 0)
+        except ValueError:
+            continue
+        if value > 0:
+            precision[row["case"]] = value
+        if drawable(row):
+            smallest[row["case"]] = min(smallest.get(row["case"], math.inf), float(row["error"]))
+    precision = {case: value for case, value in precision.items() if value >= smallest.get(case, math.inf) / 3}
+    for case, value in precision.items():
+        _, style = PLATE_STYLES.get(case, ("v", "-"))
+        ax.axhline(value, color="0.6", linewidth=0.8, linestyle=style, zorder=0)
+        ax.annotate(f"precision of the {case.removeprefix('plate_')} coefficient", (0.995, value),
+                    xycoords=("axes fraction", "data"), ha="right", va="bottom", fontsize=6.5, color="0.45")
+
+
+def main(argv):
+    if len(argv) != 3:
+        sys.stderr.write("usage: plot_convergence.py RESULTS.csv OUTPUT.png\n")
+        return 2
+    rows = read_rows(argv[1])
+    methods, panels = [], []
+    for row in rows:
+        if row["method"] not in methods:
+            methods.append(row["method"])
+        if panel_of(row["case"]) not in panels:
+            panels.append(panel_of(row["case"]))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    colour = {m: colours[i % len(colours)] for i, m in enumerate(methods)}
+
+    columns = 2 if len(panels) > 1 else 1
+    grid_rows = max(1, math.ceil(len(panels) / columns))
+    fig, axes = plt.subplots(grid_rows, columns, figsize=(16, 5.4 * grid_rows + 0.8), dpi=100, squeeze=False)
+    for ax in axes.flat[len(panels):]:
+        ax.set_visible(False)
+
+    shared_legend = {}  # dynamic panels: label -> handle (same styles in every panel)
+    for ax, panel in zip(axes.flat, panels):
+        curves = {}  # (case, method, series, window) -> rows, in file order
+        windows = []
+        for row in rows:
+            if panel_of(row["case"]) == panel and drawable(row):
+                window = row.get("window", "")
+                curves.setdefault((row["case"], row["method"], row["series"], window), []).append(row)
+                if window not in windows:
+                    windows.append(window)
+        reference = next((r["reference"] for r in rows if panel_of(r["case"]) == panel and r.get("reference")), "")
+        for (case, method, series, window), points in curves.items():
+            filled = True
+            if panel == PLATES:
+                marker, style = PLATE_STYLES.get(case, ("v", "-"))
+                label = f"{case.removeprefix('plate_')} · {method}"
+            else:
+                filled = window == windows[0]
+                marker, style = (SERIES_STYLES if filled else LATER_WINDOW_STYLES).get(series, ("v", "-"))
+                label = f"{method} · {SERIES_LABELS.get(series, series)}" + (f" · {window}" if window else "")
+            x = [float(r["wall_seconds"]) for r in points]
+            y = [float(r["error"]) for r in points]
+            (line,) = ax.plot(x, y, linestyle=style, marker=marker, color=colour[method], label=label,
+                              markersize=5, markerfacecolor=colour[method] if filled else "white")
+            if panel != PLATES:
+                shared_legend.setdefault(label, line)
+            # Label the points of the first method's curves with their resolution / time step.
+            if method == methods[0] and filled:
+                below = series == "dt"  # keeps the labels of a point shared by two series apart
+                for r, xi, yi in zip(points, x, y):
+                    ax.annotate(short_setting(r), (xi, yi), textcoords="offset points",
+                                xytext=(4, -10 if below else 4), fontsize=7, color="0.35")
+        if panel == PLATES:
+            draw_reference_precision(ax, rows)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("wall time per run [s]")
+        ax.set_ylabel("relative error [-]")
+        if panel == PLATES:
+            ax.set_title("Static square plates: centre deflection vs. analytic (Timoshenko)")
+        else:
+            title = f"{panel}: RMS surface displacement vs. reference"
+            ax.set_title(title + (f"\nreference = {reference}" if reference else ""), fontsize=10.5)
+        ax.grid(True, which="major", alpha=0.4)
+        ax.grid(True, which="minor", alpha=0.12)
+        if not curves:
+            ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
+        elif panel == PLATES:
+            ax.legend(fontsize=7, loc="upper right", ncol=2)
+    bottom = 0.0
+    if shared_legend:
+        fig.legend(list(shared_legend.values()), list(shared_legend.keys()), loc="lower center",
+                   ncol=min(4, len(shared_legend)), fontsize=8.5, frameon=False,
+                   title="dynamic cases (colour = method; line = series and error window)", title_fontsize=9)
+        bottom = 0.022 * (1.5 + math.ceil(len(shared_legend) / 4))
+    fig.suptitle("clothsim convergence study: error against run time (lower left is better)", fontsize=13)
+    fig.tight_layout(rect=(0, bottom, 1, 0.97))
+    fig.savefig(argv[2], dpi=100, metadata={"Software": None})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,502 @@
+#include "sim/study/convergence.hpp"
+
+#include "sim/dynamics/simulator.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/shell/dof_map.hpp"
+#include "sim/shell/ghost_layer.hpp"
+#include "sim/study/report_format.hpp"
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+namespace clothsim {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Surface displacement at the points from the extended-mesh displacement (#ext × 3).
+Eigen::MatrixX3d sample_displacement(const ExtendedMesh& ext, const std::vector<SurfacePoint>& points,
+                                     const Eigen::MatrixX3d& extended_displacement) {
+  return limit_sampling_matrix(ext, points) * extended_displacement;
+}
+
+MethodRun solve_loop_static(StaticProblem problem, Quadrature rule, const std::vector<SurfacePoint>& points) {
+  problem.quadrature = rule;
+  MethodRun run;
+  const Clock::time_point start = Clock::now();
+  const StaticResult result = solve_static(problem);
+  run.wall_seconds = seconds_since(start);
+  run.vertices = problem.mesh.num_vertices();
+  run.dofs = result.dofs;
+  run.solver_iterations = 1;
+  run.displacements = {sample_displacement(build_ghost_layer(problem.mesh), points, result.extended_displacement)};
+  return run;
+}
+
+MethodRun run_loop_dynamic(DynamicProblem problem, Quadrature rule, const std::vector<SurfacePoint>& points,
+                           const std::vector<double>& times) {
+  if (times.empty()) throw std::invalid_argument("run_loop_dynamic: no sample times");
+  problem.quadrature = rule;
+  problem.time.end = times.back();
+  const double slack = 1e-9 * problem.time.dt;
+  MethodRun run;
+  std::vector<Eigen::MatrixX3d> snapshots;  // extended-mesh positions at the sample times [m]
+  const Clock::time_point start = Clock::now();
+  Simulator sim(problem);
+  size_t next = 0;
+  auto take_due_samples = [&] {
+    for (; next < times.size() && sim.state().t >= times[next] - slack; ++next)
+      snapshots.push_back(sim.extended_positions());
+  };
+  for (take_due_samples(); next < times.size(); take_due_samples()) {
+    const StepStats stats = sim.step();
+    run.solver_iterations += stats.solver_iterations;
+    ++run.steps;
+  }
+  run.wall_seconds = seconds_since(start);
+  const ExtendedMesh& ext = sim.extended_mesh();
+  run.vertices = sim.num_vertices();
+  run.dofs = DofMap(ext, problem.boundary).num_free();
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> sampling = limit_sampling_matrix(ext, points);
+  for (const Eigen::MatrixX3d& x : snapshots) run.displacements.push_back(sampling * (x - ext.rest));
+  return run;
+}
+
+// sqrt(2 · area / #triangles) of the rest mesh [m]: the edge length of a uniform right-triangle
+// grid (side / n for an n × n plate grid).
+double mesh_size(const TriMesh& mesh) {
+  double area = 0.0;
+  for (const Triangle& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices.row(t[0]), b = mesh.vertices.row(t[1]), c = mesh.vertices.row(t[2]);
+    area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return mesh.triangles.empty() ? 0.0 : std::sqrt(2.0 * area / static_cast<double>(mesh.num_triangles()));
+}
+
+std::string sleeve_setting(const SleeveMesh& m, double dt) {
+  return std::to_string(m.segments) + "x" + std::to_string(m.rings) + " dt=" + format_shortest(dt);
+}
+
+// Each window's times must be positive, increasing and whole numbers of steps of `dt`.
+void check_sample_times(const SleeveStudyCase& c, double dt) {
+  for (const ErrorWindow& w : c.windows) {
+    if (w.times.empty()) throw std::invalid_argument(c.name + ": window \"" + w.name + "\" has no sample times");
+    double previous = 0.0;
+    for (double t : w.times) {
+      const double steps = t / dt;
+      if (!(t > previous) || std::abs(steps - std::round(steps)) > 1e-6 * steps)
+        throw std::invalid_argument(c.name + ": window \"" + w.name + "\": sample time " + format_shortest(t) +
+                                    " s: sample times must be positive, increasing and multiples of dt = " +
+                                    format_shortest(dt) + " s");
+      previous = t;
+    }
+  }
+}
+
+// The union of the windows' sample times, ascending [s].
+std::vector<double> all_sample_times(const SleeveStudyCase& c) {
+  std::vector<double> times;
+  for (const ErrorWindow& w : c.windows) times.insert(times.end(), w.times.begin(), w.times.end());
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  return times;
+}
+
+// The samples of `run` (taken at `all_times`) that belong to `window`.
+std::vector<Eigen::MatrixX3d> window_samples(const std::vector<Eigen::MatrixX3d>& samples,
+                                             const std::vector<double>& all_times, const ErrorWindow& window) {
+  std::vector<Eigen::MatrixX3d> out;
+  for (double t : window.times) {
+    const auto it = std::lower_bound(all_times.begin(), all_times.end(), t);
+    out.push_back(samples.at(static_cast<size_t>(it - all_times.begin())));
+  }
+  return out;
+}
+
+std::string join_times(const std::vector<double>& times) {
+  std::string out;
+  for (double t : times) {
+    if (!out.empty()) out += ' ';
+    out += format_shortest(t);
+  }
+  return out;
+}
+
+// A sleeve case's scene file with the mesh resolution and time step replaced, loaded through the
+// normal scene loader.
+class SleeveScene {
+ public:
+  explicit SleeveScene(const SleeveStudyCase& c) : case_(c) {
+    std::ifstream in(c.scene);
+    if (!in) throw SceneError(c.scene.string() + ": cannot read the scene file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    try {
+      json_ = nlohmann::json::parse(text.str());
+    } catch (const nlohmann::json::exception& e) {
+      throw SceneError(c.scene.string() + ": malformed JSON: " + e.what());
+    }
+    const nlohmann::json& mesh = json_.at("mesh");
+    if (json_.value("analysis", "static") != "dynamic" || mesh.value("primitive", "") != "cylinder" ||
+        mesh.value("angle_deg", 360.0) != 360.0)
+      throw std::invalid_argument(c.scene.string() + ": the convergence study needs a dynamic scene whose mesh is a "
+                                                     "full \"cylinder\" primitive");
+  }
+
+  DynamicProblem problem(const SleeveMesh& m, double dt) const {
+    nlohmann::json j = json_;
+    j["mesh"]["segments"] = m.segments;
+    j["mesh"]["rings"] = m.rings;
+    j["time"]["dt"] = dt;
+    j["time"]["end"] = all_sample_times(case_).back();
+    return load_scene_text(j.dump(2), case_.scene, LogFn()).dynamic;
+  }
+
+ private:
+  const SleeveStudyCase& case_;
+  nlohmann::json json_;
+};
+
+// The outcome of one run: the method's report or the reason it failed.
+struct Outcome {
+  MethodRun run;
+  double h = 0.0;
+  std::string failure;  // empty on success
+};
+
+const Method& find_method(const std::vector<Method>& methods, const std::vector<Method>& registered,
+                          const std::string& name) {
+  for (const std::vector<Method>* list : {&methods, &registered})
+    for (const Method& m : *list)
+      if (m.name == name) return m;
+  throw std::invalid_argument("unknown method \"" + name + "\"");
+}
+
+// A static solve, repeated while it is short (up to kStaticRepeats runs while their total stays
+// under kStaticRepeatSeconds) so that millisecond timings are not dominated by noise; reports the
+// last run with the shortest wall time of all.
+constexpr int kStaticRepeats = 5;
+constexpr double kStaticRepeatSeconds = 0.25;
+
+MethodRun solve_static_timed(const Method& method, const StaticProblem& problem,
+                             const std::vector<SurfacePoint>& points) {
+  MethodRun run = method.solve_static(problem, points);
+  double total = run.wall_seconds, best = run.wall_seconds;
+  for (int k = 1; k < kStaticRepeats && total + best < kStaticRepeatSeconds; ++k) {
+    run = method.solve_static(problem, points);
+    total += run.wall_seconds;
+    best = std::min(best, run.wall_seconds);
+  }
+  run.wall_seconds = best;
+  return run;
+}
+
+class StudyRunner {
+ public:
+  StudyRunner(const std::vector<Method>& methods, const LogFn& log) : methods_(methods), log_(log) {}
+
+  void run_plate(const PlateStudyCase& c, std::vector<ConvergenceRow>& rows) {
+    for (const Method& method : methods_) {
+      if (!method.solve_static) continue;
+      for (int n : c.divisions) {
+        // The method sets its own quadrature; the problem carries the default.
+        const StaticProblem problem = plate_problem(c.plate, n, Quadrature::one_point);
+        const Eigen::MatrixX2d chart = problem.mesh.vertices.leftCols<2>();  // (x, y) [m]
+        const std::vector<SurfacePoint> centre =
+            locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
+        warm_up(method, problem, centre);
+        ConvergenceRow row;
+        row.case_name = c.plate.id;
+        row.method = method.name;
+        row.series = "mesh";
+        row.window = "static";
+        row.setting = std::to_string(n) + "x" + std::to_string(n);
+        row.h = mesh_size(problem.mesh);
+        row.quantity = "centre deflection [m]";
+        row.reference_value = plate_reference_deflection(c.plate, problem);
+        row.reference_precision = c.plate.relative_precision();
+        std::ostringstream ref;
+        ref << "analytic (Timoshenko & Woinowsky-Krieger): w = " << c.plate.coefficient
+            << (c.plate.point_load ? " P a^2 / D" : " q a^4 / D");
+        row.reference = ref.str();
+        try {
+          const MethodRun run = solve_static_timed(method, problem, centre);
+          fill_run(row, run);
+          row.value = -run.displacements.at(0)(0, 2);
+          row.error = std::abs(row.value - row.reference_value) / std::abs(row.reference_value);
+        } catch (const std::exception& e) {
+          mark_failed(row, e.what());
+        }
+        report(row);
+        rows.push_back(row);
+      }
+    }
+  }
+
+  void run_sleeve(const SleeveStudyCase& c, std::vector<ConvergenceRow>& rows) {
+    if (c.windows.empty()) throw std::invalid_argument(c.name + ": no error windows");
+    for (double dt : c.dts) check_sample_times(c, dt);
+    check_sample_times(c, c.mesh_dt);
+    check_sample_times(c, c.reference_dt);
+    const Method& reference_method = find_method(methods_, registered_, c.reference_method);
+    const SleeveScene scene(c);
+    const std::vector<double> times = all_sample_times(c);
+    cache_.clear();
+
+    const Outcome& reference = outcome(c, scene, times, reference_method, c.reference_mesh, c.reference_dt);
+    const std::string reference_text =
+        "finest run: " + reference_method.name + " " + sleeve_setting(c.reference_mesh, c.reference_dt);
+
+    auto add = [&](const Method& method, const std::string& series, const SleeveMesh& m, double dt) {
+      const Outcome& o = outcome(c, scene, times, method, m, dt);
+      for (const ErrorWindow& window : c.windows) {
+        ConvergenceRow row;
+        row.case_name = c.name;
+        row.method = method.name;
+        row.series = series;
+        row.window = window.name;
+        row.setting = sleeve_setting(m, dt);
+        row.h = o.h;
+        row.dt = dt;
+        row.quantity = "RMS surface displacement [m] at " + std::to_string(c.grid_theta) + "x" +
+                       std::to_string(c.grid_s) + " (theta s) points; t = " + join_times(window.times) + " s";
+        row.reference = reference_text;
+        fill_run(row, o.run);
+        if (!reference.failure.empty()) {
+          mark_failed(row, "the reference run failed: " + reference.failure);
+        } else {
+          const std::vector<Eigen::MatrixX3d> u_ref = window_samples(reference.run.displacements, times, window);
+          row.reference_value = rms_norm(u_ref);
+          if (!o.failure.empty()) {
+            mark_failed(row, o.failure);
+          } else {
+            const std::vector<Eigen::MatrixX3d> u = window_samples(o.run.displacements, times, window);
+            row.value = rms_norm(u);
+            row.error = relative_rms_difference(u, u_ref);
+            if (&o == &reference) row.note = "the reference run itself (error 0 by definition)";
+          }
+        }
+        report(row);
+        rows.push_back(row);
+      }
+    };
+
+    add(reference_method, "reference", c.reference_mesh, c.reference_dt);
+    for (const Method& method : methods_) {
+      if (!method.run_dynamic) continue;
+      for (const SleeveMesh& m : c.meshes) add(method, "mesh", m, c.mesh_dt);
+      for (double dt : c.dts) add(method, "dt", c.dt_mesh, dt);
+    }
+  }
+
+ private:
+  // One untimed solve before a method's first timed static run, so that one-time start-up
+  // (thread pools, allocator growth) is not charged to the first row.
+  void warm_up(const Method& method, const StaticProblem& problem, const std::vector<SurfacePoint>& points) {
+    if (!warmed_up_.insert(method.name).second) return;
+    try {
+      method.solve_static(problem, points);
+    } catch (const std::exception&) {
+      // the timed run reports the failure
+    }
+  }
+
+  static void fill_run(ConvergenceRow& row, const MethodRun& run) {
+    row.vertices = run.vertices;
+    row.dofs = run.dofs;
+    row.steps = run.steps;
+    row.wall_seconds = run.wall_seconds;
+    row.solver_iterations = run.solver_iterations;
+  }
+
+  static void mark_failed(ConvergenceRow& row, const std::string& why) {
+    row.error = std::numeric_limits<double>::quiet_NaN();
+    row.note = "failed: " + why;
+  }
+
+  void report(const ConvergenceRow& row) const {
+    if (!log_) return;
+    log_("case " + row.case_name + " method " + row.method + " setting " + row.setting +
+         (row.window.empty() || row.window == "static" ? "" : " window " + row.window) + " error " +
+         format_significant(row.error, 4) + " (" + format_fixed(row.wall_seconds, 2) + " s)" +
+         (row.note.empty() ? "" : " [" + row.note + "]"));
+  }
+
+  // The run of `method` on mesh m at time step dt, computed once per case.
+  const Outcome& outcome(const SleeveStudyCase& c, const SleeveScene& scene, const std::vector<double>& times,
+                         const Method& method, const SleeveMesh& m, double dt) {
+    const std::string key = method.name + " " + sleeve_setting(m, dt);
+    if (auto it = cache_.find(key); it != cache_.end()) return it->second;
+    Outcome o;
+    const DynamicProblem problem = scene.problem(m, dt);
+    o.h = mesh_size(problem.mesh);
+    const std::vector<SurfacePoint> points =
+        locate_points(problem.mesh.triangles, cylinder_chart(problem.mesh.vertices),
+                      cylinder_parameter_grid(c.grid_theta, c.grid_s), 2 * std::numbers::pi);
+    try {
+      o.run = method.run_dynamic(problem, points, times);
+    } catch (const std::exception& e) {
+      o.failure = e.what();
+    }
+    return cache_.emplace(key, std::move(o)).first->second;
+  }
+
+  const std::vector<Method>& methods_;
+  const std::vector<Method> registered_ = convergence_methods();
+  const LogFn& log_;
+  std::map<std::string, Outcome> cache_;
+  std::set<std::string> warmed_up_;  // methods that have had their untimed static solve
+};
+
+// Observed orders between consecutive rows of the same case, method and series.
+void fill_orders(std::vector<ConvergenceRow>& rows) {
+  std::map<std::string, const ConvergenceRow*> previous;
+  for (ConvergenceRow& row : rows) {
+    if (row.series == "reference") continue;
+    const std::string key = row.case_name + "\n" + row.method + "\n" + row.series + "\n" + row.window;
+    if (auto it = previous.find(key); it != previous.end()) {
+      const ConvergenceRow& p = *it->second;
+      const double x0 = row.series == "dt" ? p.dt : p.h, x1 = row.series == "dt" ? row.dt : row.h;
+      if (p.error > 0 && row.error > 0 && std::isfinite(p.error) && std::isfinite(row.error) && x0 > 0 && x1 > 0 &&
+          x0 != x1)
+        row.order = std::log(p.error / row.error) / std::log(x0 / x1);
+    }
+    previous[key] = &row;
+  }
+}
+
+}  // namespace
+
+Method loop_subdivision_method(const std::string& name, Quadrature rule) {
+  Method m;
+  m.name = name;
+  m.description = std::string("Loop subdivision shell element, ") + to_string(rule) + " quadrature";
+  m.solve_static = [rule](const StaticProblem& problem, const std::vector<SurfacePoint>& points) {
+    return solve_loop_static(problem, rule, points);
+  };
+  m.run_dynamic = [rule](const DynamicProblem& problem, const std::vector<SurfacePoint>& points,
+                         const std::vector<double>& times) { return run_loop_dynamic(problem, rule, points, times); };
+  return m;
+}
+
+std::vector<Method> convergence_methods() {
+  return {
+      loop_subdivision_method("loop_one_point", Quadrature::one_point),
+      loop_subdivision_method("loop_three_point", Quadrature::three_point),
+  };
+}
+
+ConvergencePlan full_convergence_plan(const std::filesystem::path& scenes_dir) {
+  ConvergencePlan plan;
+  for (const AnalyticPlate& plate : kAnalyticPlates) plan.plates.push_back({plate, {8, 16, 32, 64, 128}});
+  // Segments × rings keep the shipped sleeve's aspect (26 × 19: rings − 1 ≈ 0.69 · segments);
+  // segments are even so that the gravity sleeve's pegs at θ = 0 and π are vertices. The mesh
+  // series runs at the reference time step and the time-step series on the reference mesh, so
+  // each isolates one source of error (the reference run itself shows up in both with error 0).
+  const std::vector<SleeveMesh> meshes = {{14, 11}, {20, 15}, {26, 19}, {40, 29}, {52, 37}};
+  // "early" ends before the first buckling bifurcation of each scene (measured at 52 × 37:
+  // docs/convergence.md); "long" runs well past it. Times are multiples of every time step.
+  const std::vector<double> long_window = {0.04, 0.08, 0.12, 0.16, 0.2};
+  const std::pair<const char*, std::vector<double>> scenes[] = {
+      {"sleeve_gravity", {0.008, 0.016, 0.024, 0.032}},
+      {"sleeve_twist", {0.008, 0.016, 0.024}},
+      {"sleeve_compress", {0.004, 0.008}},
+  };
+  for (const auto& [name, early] : scenes) {
+    SleeveStudyCase c;
+    c.name = name;
+    c.scene = scenes_dir / (std::string(name) + ".json");
+    c.windows = {{"early", early}, {"long", long_window}};
+    c.meshes = meshes;
+    c.mesh_dt = 5e-4;
+    c.dt_mesh = meshes.back();
+    c.dts = {4e-3, 2e-3, 1e-3, 5e-4};
+    c.reference_mesh = meshes.back();
+    c.reference_dt = 5e-4;
+    plan.sleeves.push_back(c);
+  }
+  return plan;
+}
+
+ConvergencePlan quick_convergence_plan(const std::filesystem::path& scenes_dir) {
+  ConvergencePlan plan;
+  plan.plates.push_back({kAnalyticPlates[0], {4, 8, 16}});
+  SleeveStudyCase c;
+  c.name = "sleeve_twist";
+  c.scene = scenes_dir / "sleeve_twist.json";
+  c.windows = {{"early", {0.01, 0.02}}};
+  c.grid_theta = 16;
+  c.grid_s = 8;
+  c.meshes = {{8, 6}, {12, 9}};
+  c.mesh_dt = 2e-3;
+  c.dt_mesh = {12, 9};
+  c.dts = {1e-2, 5e-3, 2e-3};
+  c.reference_mesh = {16, 11};
+  c.reference_dt = 1e-3;
+  plan.sleeves.push_back(c);
+  return plan;
+}
+
+std::vector<ConvergenceRow> run_convergence(const ConvergencePlan& plan, const std::vector<Method>& methods,
+                                            const LogFn& log) {
+  std::vector<ConvergenceRow> rows;
+  StudyRunner runner(methods, log);
+  for (const PlateStudyCase& c : plan.plates) runner.run_plate(c, rows);
+  for (const SleeveStudyCase& c : plan.sleeves) runner.run_sleeve(c, rows);
+  fill_orders(rows);
+  return rows;
+}
+
+const std::vector<std::string>& results_csv_columns() {
+  static const std::vector<std::string> columns = {
+      "case",     "method", "series",          "window",              "setting",   "vertices", "dofs",
+      "h",        "dt",     "steps",           "wall_seconds",        "solver_iterations",     "error",
+      "order",    "quantity", "value",         "reference_value",     "reference_precision",   "reference",
+      "note"};
+  return columns;
+}
+
+void write_results_csv(std::ostream& out, const std::vector<ConvergenceRow>& rows) {
+  const std::vector<std::string>& columns = results_csv_columns();
+  for (size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
+  out << '\n';
+  for (const ConvergenceRow& r : rows)
+    out << csv_field(r.case_name) << ',' << csv_field(r.method) << ',' << csv_field(r.series) << ','
+        << csv_field(r.window) << ',' << csv_field(r.setting) << ',' << r.vertices << ',' << r.dofs << ',' << format_shortest(r.h) << ','
+        << format_shortest(r.dt) << ',' << r.steps << ',' << format_fixed(r.wall_seconds, 6) << ','
+        << r.solver_iterations << ',' << format_shortest(r.error) << ','
+        << (r.order ? format_shortest(*r.order) : "") << ',' << csv_field(r.quantity) << ','
+        << format_shortest(r.value) << ',' << format_shortest(r.reference_value) << ','
+        << format_shortest(r.reference_precision) << ',' << csv_field(r.reference)
+        << ',' << csv_field(r.note) << '\n';
+}
+
+void write_results_markdown(std::ostream& out, const std::vector<ConvergenceRow>& rows) {
+  out << "| case | method | series | window | setting | vertices | dofs | dt [s] | wall [s] | solver iterations | "
+         "error | order |\n|---|---|---|---|---|--:|--:|--:|--:|--:|--:|--:|\n";
+  for (const ConvergenceRow& r : rows)
+    out << "| " << markdown_cell(r.case_name) << " | " << markdown_cell(r.method) << " | " << r.series << " | "
+        << markdown_cell(r.window) << " | " << markdown_cell(r.setting) << " | " << r.vertices << " | " << r.dofs << " | "
+        << (r.dt > 0 ? format_shortest(r.dt) : "–") << " | " << format_fixed(r.wall_seconds, 3) << " | "
+        << r.solver_iterations << " | " << format_significant(r.error, 3) << " | "
+        << (r.order ? format_fixed(*r.order, 2) : "") << " |\n";
+}
+
+}  // namespace clothsim

@@ -1,0 +1,288 @@
+// The convergence study's machinery (sim/study/convergence.hpp, surface_sampling.hpp): parameter
+// points and the limit-surface sampling operator (rigid motions, seam, agreement with the limit
+// points of solve_static), the relative RMS norm, the plate series (error falls at second order),
+// a tiny sleeve series against its reference, the method registry, and the CSV columns.
+#include "sim/study/convergence.hpp"
+
+#include "sim/mesh/generators.hpp"
+#include "sim/shell/ghost_layer.hpp"
+#include "sim/study/plates.hpp"
+#include "sim/study/surface_sampling.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace clothsim {
+namespace {
+
+constexpr double kTwoPi = 2 * std::numbers::pi;
+
+std::vector<SurfacePoint> cylinder_points(const TriMesh& mesh, int n_theta, int n_s) {
+  return locate_points(mesh.triangles, cylinder_chart(mesh.vertices), cylinder_parameter_grid(n_theta, n_s), kTwoPi);
+}
+
+TEST(SurfaceSampling, LocatedPointsReproduceTheirChartCoordinates) {
+  const TriMesh mesh = make_cylinder(0.05, 0.2, 13, 10);
+  const Eigen::MatrixX2d chart = cylinder_chart(mesh.vertices);
+  const Eigen::MatrixX2d targets = cylinder_parameter_grid(32, 16);
+  const std::vector<SurfacePoint> points = locate_points(mesh.triangles, chart, targets, kTwoPi);
+  ASSERT_EQ(points.size(), 32u * 16u);
+  int seam = 0;
+  for (size_t p = 0; p < points.size(); ++p) {
+    const Triangle& t = mesh.triangles[static_cast<size_t>(points[p].triangle)];
+    const double v = points[p].v, w = points[p].w;
+    EXPECT_GE(v, 0.0);
+    EXPECT_GE(w, 0.0);
+    EXPECT_LE(v + w, 1.0);
+    // Unwrap the triangle's angles next to its first vertex, as a seam triangle needs.
+    double theta[3], s = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      theta[k] = chart(t[k], 0);
+      if (k > 0) theta[k] -= kTwoPi * std::round((theta[k] - theta[0]) / kTwoPi);
+    }
+    if (std::abs(theta[1] - chart(t[1], 0)) > 1 || std::abs(theta[2] - chart(t[2], 0)) > 1) ++seam;
+    s = (1 - v - w) * chart(t[0], 1) + v * chart(t[1], 1) + w * chart(t[2], 1);
+    const double angle = (1 - v - w) * theta[0] + v * theta[1] + w * theta[2];
+    const Eigen::Index row = static_cast<Eigen::Index>(p);
+    EXPECT_NEAR(std::remainder(angle - targets(row, 0), kTwoPi), 0.0, 1e-12) << "point " << p;
+    EXPECT_NEAR(s, targets(row, 1), 1e-12) << "point " << p;
+  }
+  EXPECT_GT(seam, 0) << "no point fell into a triangle across the seam θ = 0";
+}
+
+TEST(SurfaceSampling, PointOutsideTheMeshIsAnError) {
+  const TriMesh mesh = make_grid(1.0, 1.0, 2, 2);
+  const Eigen::MatrixX2d chart = mesh.vertices.leftCols<2>();
+  EXPECT_THROW(locate_points(mesh.triangles, chart, Eigen::MatrixX2d::Constant(1, 2, 0.7)), std::invalid_argument);
+}
+
+// The displacement field of a rigid motion x = Q X + c, sampled at parameter points, is the rigid
+// motion of the rest limit points: W (Q X + c − X) = (Q − I) W X + c (the rows of W sum to 1).
+TEST(SurfaceSampling, RigidMotionGivesItsOwnDisplacement) {
+  const TriMesh mesh = make_cylinder(0.05, 0.2, 13, 10);
+  const ExtendedMesh ext = build_ghost_layer(mesh);
+  const std::vector<SurfacePoint> points = cylinder_points(mesh, 32, 16);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> w = limit_sampling_matrix(ext, points);
+  ASSERT_EQ(w.rows(), 32 * 16);
+  ASSERT_EQ(w.cols(), ext.num_vertices());
+  const Eigen::VectorXd row_sums = w * Eigen::VectorXd::Ones(w.cols());
+  EXPECT_LT((row_sums.array() - 1.0).abs().maxCoeff(), 1e-14);
+
+  const Eigen::Matrix3d q = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, -0.5).normalized()).toRotationMatrix();
+  const Eigen::RowVector3d c(0.03, -0.2, 0.11);
+  const Eigen::MatrixX3d moved = (ext.rest * q.transpose()).rowwise() + c;
+  const Eigen::MatrixX3d u = w * (moved - ext.rest);
+  const Eigen::MatrixX3d rest_points = w * ext.rest;
+  const Eigen::MatrixX3d expected = (rest_points * (q - Eigen::Matrix3d::Identity()).transpose()).rowwise() + c;
+  EXPECT_LT((u - expected).cwiseAbs().maxCoeff(), 1e-12);
+  // The rest limit points lie close to the cylinder (the limit surface of a coarse polygon sits
+  // slightly inside it) at the requested height.
+  const Eigen::MatrixX2d grid = cylinder_parameter_grid(32, 16);
+  for (Eigen::Index p = 0; p < rest_points.rows(); ++p) {
+    EXPECT_NEAR(std::hypot(rest_points(p, 0), rest_points(p, 2)), 0.05, 2e-3) << "point " << p;
+    EXPECT_NEAR(rest_points(p, 1), 0.2 * grid(p, 1), 1e-12) << "point " << p;
+  }
+}
+
+// At a control vertex the sampling operator gives the vertex's limit point: the plate centre
+// sampled through the chart equals solve_static's limit displacement there.
+TEST(SurfaceSampling, PlateCentreMatchesTheLimitDisplacementOfTheCentreVertex) {
+  const StaticProblem problem = plate_problem(kAnalyticPlates[0], 8, Quadrature::one_point);
+  const StaticResult result = solve_static(problem);
+  const Eigen::MatrixX2d chart = problem.mesh.vertices.leftCols<2>();
+  const std::vector<SurfacePoint> centre = locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
+  const Eigen::MatrixX3d u =
+      limit_sampling_matrix(build_ghost_layer(problem.mesh), centre) * result.extended_displacement;
+  const int vertex = nearest_vertex(problem.mesh, Eigen::Vector3d::Zero());
+  EXPECT_NEAR(u(0, 2), result.limit_displacement(vertex, 2), 1e-12 * std::abs(result.limit_displacement(vertex, 2)));
+}
+
+TEST(SurfaceSampling, RelativeRmsDifference) {
+  const std::vector<Eigen::MatrixX3d> ref = {Eigen::MatrixX3d::Random(20, 3), Eigen::MatrixX3d::Random(20, 3)};
+  EXPECT_EQ(relative_rms_difference(ref, ref), 0.0);
+  std::vector<Eigen::MatrixX3d> twice = ref;
+  for (Eigen::MatrixX3d& m : twice) m *= 2;
+  EXPECT_NEAR(relative_rms_difference(twice, ref), 1.0, 1e-14);
+  EXPECT_NEAR(rms_norm(twice), 2 * rms_norm(ref), 1e-14);
+  // A uniform offset d of every point against u_ref = e_x: error = |d|.
+  const std::vector<Eigen::MatrixX3d> unit = {Eigen::MatrixX3d::Constant(5, 3, 0.0).rowwise() + Eigen::RowVector3d(1, 0, 0)};
+  const std::vector<Eigen::MatrixX3d> off = {unit[0].rowwise() + Eigen::RowVector3d(0, 0.03, 0.04)};
+  EXPECT_NEAR(relative_rms_difference(off, unit), 0.05, 1e-14);
+  EXPECT_THROW(relative_rms_difference({ref[0]}, ref), std::invalid_argument);
+  EXPECT_THROW(relative_rms_difference(ref, {Eigen::MatrixX3d::Zero(20, 3), Eigen::MatrixX3d::Zero(20, 3)}),
+               std::invalid_argument);
+}
+
+ConvergencePlan plate_plan(std::vector<int> divisions) {
+  ConvergencePlan plan;
+  plan.plates.push_back({kAnalyticPlates[0], std::move(divisions)});
+  return plan;
+}
+
+// Simply supported plate under uniform load, 8², 16², 32²: the relative error of the centre
+// deflection falls strictly, at about second order, and is small on the finest grid (measured:
+// one-point 4.1 %, 0.96 %, 0.23 %; three-point 0.50 %, 0.13 %, 0.032 %).
+TEST(ConvergenceStudy, PlateErrorFallsWithRefinement) {
+  const std::vector<ConvergenceRow> rows = run_convergence(plate_plan({8, 16, 32}), convergence_methods(), {});
+  ASSERT_EQ(rows.size(), 6u);
+  for (size_t m = 0; m < 2; ++m) {
+    const ConvergenceRow* r = &rows[3 * m];
+    EXPECT_EQ(r[0].method, m == 0 ? "loop_one_point" : "loop_three_point");
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(r[k].case_name, "plate_ss_uniform");
+      EXPECT_EQ(r[k].series, "mesh");
+      EXPECT_EQ(r[k].dt, 0.0);
+      EXPECT_GT(r[k].wall_seconds, 0.0);
+      EXPECT_GT(r[k].dofs, 0);
+      EXPECT_TRUE(r[k].note.empty()) << r[k].note;
+    }
+    EXPECT_EQ(r[0].setting, "8x8");
+    EXPECT_EQ(r[2].vertices, 33 * 33);
+    EXPECT_LT(r[1].error, r[0].error) << r[1].method;
+    EXPECT_LT(r[2].error, r[1].error) << r[2].method;
+    EXPECT_LT(r[2].error, m == 0 ? 0.003 : 0.0005) << r[2].method;
+    EXPECT_FALSE(r[0].order.has_value());
+    for (int k = 1; k < 3; ++k) {
+      ASSERT_TRUE(r[k].order.has_value());
+      EXPECT_GT(*r[k].order, 1.8) << r[k].method << " " << r[k].setting;
+      EXPECT_LT(*r[k].order, 2.3) << r[k].method << " " << r[k].setting;
+    }
+    EXPECT_NEAR(r[2].reference_value, 0.00406235 / (1e7 * 1e-6 / 12 / (1 - 0.09)), 1e-15);
+  }
+}
+
+// The quick plan's sleeve (twist to 0.02 s), here with two error windows: the reference rows have
+// error 0 and a note, the mesh series' error falls from 8 × 6 to 12 × 9, every run has its figures,
+// and the run shared by the mesh and time-step series (12 × 9 at 2 ms) is reported identically in
+// both. Rows come per run, one for each window.
+TEST(ConvergenceStudy, SleeveSeriesAgainstTheFinestRun) {
+  ConvergencePlan plan = quick_convergence_plan(CLOTHSIM_SOURCE_DIR "/scenes");
+  plan.plates.clear();
+  ASSERT_EQ(plan.sleeves.size(), 1u);
+  plan.sleeves[0].windows = {{"early", {0.01, 0.02}}, {"first", {0.01}}};
+  const std::vector<Method> methods = {convergence_methods()[0]};  // the reference method joins anyway
+  const std::vector<ConvergenceRow> all = run_convergence(plan, methods, {});
+  ASSERT_EQ(all.size(), 2 * (1u + 2u + 3u));
+  std::vector<ConvergenceRow> rows, first;
+  for (const ConvergenceRow& r : all) (r.window == "early" ? rows : first).push_back(r);
+  ASSERT_EQ(rows.size(), first.size());
+  for (size_t k = 0; k < rows.size(); ++k) {
+    EXPECT_EQ(first[k].window, "first");
+    EXPECT_EQ(first[k].setting, rows[k].setting);
+    EXPECT_EQ(first[k].wall_seconds, rows[k].wall_seconds);  // the same run
+    EXPECT_LT(first[k].value, rows[k].value);  // the sleeve twists further after 0.01 s
+  }
+  EXPECT_EQ(rows[0].series, "reference");
+  EXPECT_EQ(rows[0].method, "loop_three_point");
+  EXPECT_EQ(rows[0].error, 0.0);
+  EXPECT_FALSE(rows[0].note.empty());
+  EXPECT_EQ(rows[0].value, rows[0].reference_value);
+  for (const ConvergenceRow& r : all) {
+    EXPECT_EQ(r.case_name, "sleeve_twist");
+    EXPECT_GT(r.steps, 0);
+    EXPECT_GT(r.solver_iterations, 0);
+    EXPECT_GT(r.value, 0.0);
+    EXPECT_TRUE(std::isfinite(r.error));
+    EXPECT_NEAR(r.steps * r.dt, 0.02, 1e-12);
+  }
+  EXPECT_EQ(rows[1].series, "mesh");
+  EXPECT_EQ(rows[1].setting, "8x6 dt=0.002");
+  EXPECT_LT(rows[2].error, rows[1].error);
+  EXPECT_LT(rows[2].error, 0.05);
+  EXPECT_EQ(rows[5].series, "dt");
+  EXPECT_EQ(rows[5].setting, rows[2].setting);
+  EXPECT_EQ(rows[5].error, rows[2].error);
+  EXPECT_EQ(rows[5].wall_seconds, rows[2].wall_seconds);
+}
+
+TEST(ConvergenceStudy, SampleTimesMustBeMultiplesOfEveryTimeStep) {
+  ConvergencePlan plan = quick_convergence_plan(CLOTHSIM_SOURCE_DIR "/scenes");
+  plan.plates.clear();
+  plan.sleeves[0].dts.push_back(3e-3);
+  EXPECT_THROW(run_convergence(plan, convergence_methods(), {}), std::invalid_argument);
+}
+
+// A method is one registration: a made-up static-only method joins the plate case (and no
+// sleeve case), with its own name in the rows.
+TEST(ConvergenceStudy, ExtraMethodsBecomeExtraRows) {
+  const std::vector<Method> registered = convergence_methods();
+  ASSERT_EQ(registered.size(), 2u);
+  EXPECT_EQ(registered[0].name, "loop_one_point");
+  EXPECT_EQ(registered[1].name, "loop_three_point");
+
+  Method exact;
+  exact.name = "analytic_times_1.01";
+  exact.solve_static = [](const StaticProblem& problem, const std::vector<SurfacePoint>& points) {
+    MethodRun run;
+    run.vertices = problem.mesh.num_vertices();
+    run.displacements = {Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points.size()), 3)};
+    run.displacements[0](0, 2) = -1.01 * plate_reference_deflection(kAnalyticPlates[0], problem);
+    return run;
+  };
+  const std::vector<ConvergenceRow> rows = run_convergence(plate_plan({4}), {registered[0], exact}, {});
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[1].method, "analytic_times_1.01");
+  EXPECT_NEAR(rows[1].error, 0.01, 1e-12);
+}
+
+TEST(ConvergenceStudy, FailedRunsAreRecordedNotFatal) {
+  Method broken;
+  broken.name = "broken";
+  broken.solve_static = [](const StaticProblem&, const std::vector<SurfacePoint>&) -> MethodRun {
+    throw std::runtime_error("singular, on purpose");
+  };
+  const std::vector<ConvergenceRow> rows = run_convergence(plate_plan({4}), {broken}, {});
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_TRUE(std::isnan(rows[0].error));
+  EXPECT_NE(rows[0].note.find("singular, on purpose"), std::string::npos) << rows[0].note;
+}
+
+// Line n (from 0) of `text`, without its line break.
+std::string nth_line(const std::string& text, int n) {
+  size_t start = 0;
+  for (int k = 0; k < n && start != std::string::npos; ++k) {
+    start = text.find('\n', start);
+    if (start != std::string::npos) ++start;
+  }
+  if (start == std::string::npos) return "";
+  return text.substr(start, text.find('\n', start) - start);
+}
+
+TEST(ConvergenceStudy, CsvHasTheDocumentedColumnsAndOneLinePerRun) {
+  const std::vector<std::string> expected = {
+      "case",     "method",       "series",            "window", "setting", "vertices",        "dofs",
+      "h",        "dt",           "steps",             "wall_seconds",      "solver_iterations", "error",
+      "order",    "quantity",     "value",             "reference_value",   "reference_precision", "reference",
+      "note"};
+  EXPECT_EQ(results_csv_columns(), expected);
+
+  std::vector<ConvergenceRow> rows = run_convergence(plate_plan({4, 8}), convergence_methods(), {});
+  ASSERT_EQ(rows.size(), 4u);
+  rows[0].note = "a, \"quoted\" note";
+  std::ostringstream csv;
+  write_results_csv(csv, rows);
+  const std::string text = csv.str();
+  EXPECT_EQ(static_cast<size_t>(std::count(text.begin(), text.end(), '\n')), rows.size() + 1);
+  EXPECT_EQ(nth_line(text, 0),
+            "case,method,series,window,setting,vertices,dofs,h,dt,steps,wall_seconds,solver_iterations,error,order,"
+            "quantity,value,reference_value,reference_precision,reference,note");
+  EXPECT_EQ(nth_line(text, 1).rfind("plate_ss_uniform,loop_one_point,mesh,static,4x4,25,", 0), 0u) << text;
+  EXPECT_NE(nth_line(text, 1).find(",\"a, \"\"quoted\"\" note\""), std::string::npos) << text;
+  EXPECT_NE(nth_line(text, 2).find(",mesh,static,8x8,81,"), std::string::npos) << text;
+
+  std::ostringstream md;
+  write_results_markdown(md, rows);
+  const std::string table = md.str();
+  EXPECT_EQ(static_cast<size_t>(std::count(table.begin(), table.end(), '\n')), rows.size() + 2);
+}
+
+}  // namespace
+}  // namespace clothsim
