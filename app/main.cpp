@@ -1,6 +1,7 @@
 // Command-line entry point: `clothsim SCENE.json [--out DIR] [--end T]`. Argument parsing (CLI11)
 // lives in this file only; the work is done by run_scene_file (app/run.hpp).
 #include "app/run.hpp"
+#include "app/study.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -34,16 +35,46 @@ int render_command(int argc, char** argv) {
   return clothsim::render_saved_frames(dir, width, height);
 }
 
+// `clothsim study convergence|stability [--out DIR] [--quick] [--no-plot]`.
+int study_command(int argc, char** argv) {
+  CLI::App app{"clothsim study: the reports of error against run time (convergence) and of numerical\n"
+               "stability on stiff and extreme cases (stability); see README.md, \"Studies\".",
+               "clothsim study"};
+  std::string which;
+  clothsim::StudyOptions options;
+  std::string out = options.out_root.string();
+  bool no_plot = false;
+  app.add_option("study", which, "convergence or stability")
+      ->required()
+      ->check(CLI::IsMember({"convergence", "stability"}))
+      ->type_name("NAME");
+  app.add_option("--out", out, "Output root; the report goes to DIR/study_<NAME>/")->type_name("DIR")->capture_default_str();
+  app.add_flag("--quick", options.quick, "Run a small subset of the cases (seconds; used by the tests)");
+  app.add_flag("--no-plot", no_plot, "Write the data but no PNG (no python3-matplotlib needed)");
+  try {
+    app.parse(argc - 1, argv + 1);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "clothsim: error: " << e.what() << "\nRun with --help for usage.\n";
+    return 1;
+  }
+  options.out_root = out;
+  options.plot = !no_plot;
+  return which == "convergence" ? clothsim::run_convergence_study(options) : clothsim::run_stability_study(options);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "render") return render_command(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "study") return study_command(argc, argv);
   CLI::App app{
       "clothsim: Kirchhoff-Love thin-shell cloth simulator on Loop-subdivision surfaces.\n"
       "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes\n"
       "its results to DIR/<scene name>/: result.json and limit.obj for a static scene;\n"
       "probes.csv, stats.csv, summary.json, frame_NNNN.png and (with output.obj) frames/ for a\n"
-      "dynamic one. `clothsim render DIR` draws a run's saved frames/mesh_*.obj again.",
+      "dynamic one. `clothsim render DIR` draws a run's saved frames/mesh_*.obj again;\n"
+      "`clothsim study convergence|stability` writes the reports of README.md, \"Studies\".",
       "clothsim"};
   std::string scene;
   std::string out = "out";
