@@ -1,5 +1,8 @@
 #include "app/output_folders.hpp"
 
+#include <unistd.h>
+
+#include <cstdint>
 #include <system_error>
 
 namespace clothsim {
@@ -12,6 +15,30 @@ std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& 
     if (p == p.parent_path()) break;
   }
   return missing;
+}
+
+std::string replace_folder(const std::filesystem::path& staging, const std::filesystem::path& target) {
+  namespace fs = std::filesystem;
+  std::string old_name = ".";  // built with += (GCC 12 warns falsely on "." + std::string&&)
+  old_name += target.filename().string();
+  old_name += ".old-";
+  old_name += std::to_string(static_cast<long>(::getpid()));
+  const fs::path old = target.parent_path() / old_name;
+  std::error_code ec;
+  const bool replacing = fs::exists(fs::symlink_status(target));
+  if (replacing) {
+    fs::remove_all(old, ec);
+    fs::rename(target, old);
+  }
+  try {
+    fs::rename(staging, target);
+  } catch (...) {
+    if (replacing) fs::rename(old, target, ec);
+    throw;
+  }
+  if (replacing && fs::remove_all(old, ec) == static_cast<std::uintmax_t>(-1))
+    return "could not remove the previous output " + old.string() + ": " + ec.message();
+  return "";
 }
 
 }  // namespace clothsim

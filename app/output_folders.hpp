@@ -2,6 +2,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace clothsim {
@@ -9,5 +10,11 @@ namespace clothsim {
 // The missing ancestors of `dir` (deepest first), i.e. the folders create_directories(dir)
 // would make; used to remove exactly those again when a run fails.
 std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& dir);
+
+// Renames the finished folder `staging` to `target`, replacing an older `target` only once the
+// new one is in place: the old one is moved aside to a hidden sibling (".<name>.old-<pid>"),
+// restored if the rename fails (and the error rethrown), and deleted afterwards. Returns a
+// warning (empty if none) when the old folder could not be deleted.
+std::string replace_folder(const std::filesystem::path& staging, const std::filesystem::path& target);
 
 }  // namespace clothsim

@@ -72,7 +72,6 @@ void publish(const fs::path& root, const std::string& name, const std::function<
   const std::string pid = std::to_string(static_cast<long>(::getpid()));
   const fs::path final_dir = root / name;
   const fs::path tmp = root / ("." + name + ".tmp-" + pid);
-  const fs::path old = root / ("." + name + ".old-" + pid);
   const std::vector<fs::path> created = missing_folders(root);
   std::error_code ec;
   try {
@@ -80,16 +79,7 @@ void publish(const fs::path& root, const std::string& name, const std::function<
     fs::remove_all(tmp);
     fs::create_directory(tmp);
     write(tmp);
-    const bool replacing = fs::exists(fs::symlink_status(final_dir));
-    if (replacing) fs::rename(final_dir, old);
-    try {
-      fs::rename(tmp, final_dir);
-    } catch (...) {
-      if (replacing) fs::rename(old, final_dir, ec);
-      throw;
-    }
-    if (replacing && fs::remove_all(old, ec) == static_cast<std::uintmax_t>(-1))
-      log_line("warning: could not remove the previous output " + old.string() + ": " + ec.message());
+    if (const std::string warning = replace_folder(tmp, final_dir); !warning.empty()) log_line("warning: " + warning);
   } catch (...) {
     fs::remove_all(tmp, ec);
     for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if empty

@@ -39,20 +39,6 @@ void write_text_file(const fs::path& path, const std::string& what, void (*write
   if (!out) throw std::runtime_error("writing " + path.string() + " failed");
 }
 
-// Moves `staging` to `target`, replacing an older `target` only once the new one is in place.
-void publish(const fs::path& staging, const fs::path& target) {
-  const fs::path old = target.parent_path() / (".study_convergence.old-" + std::to_string(::getpid()));
-  const bool had_old = fs::exists(target);
-  if (had_old) fs::rename(target, old);
-  try {
-    fs::rename(staging, target);
-  } catch (...) {
-    if (had_old) fs::rename(old, target);
-    throw;
-  }
-  if (had_old) fs::remove_all(old);
-}
-
 }  // namespace
 
 int run_convergence_study(const StudyOptions& options) {
@@ -78,7 +64,8 @@ int run_convergence_study(const StudyOptions& options) {
     std::string plot_error;
     if (options.plot)
       plot_error = run_plot_script("plot_convergence.py", {csv.string(), (staging / "error_vs_time.png").string()});
-    publish(staging, target);
+    if (const std::string warning = replace_folder(staging, target); !warning.empty())
+      std::cerr << "clothsim: warning: " << warning << '\n';
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cout << "convergence study: " << rows.size() << " rows in " << format_fixed(seconds, 1) << " s; wrote "
               << (target / "results.csv").string() << (options.plot && plot_error.empty() ? " and error_vs_time.png" : "")

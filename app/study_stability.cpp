@@ -4,6 +4,7 @@
 // `clothsim DIR/study_stability/scenes/<case>.json` reruns it). The folder is built under a
 // temporary sibling name and renamed into place at the end. Exit code 1 on an error or when any
 // case fails (the report is written all the same).
+#include "app/output_folders.hpp"
 #include "app/plotting.hpp"
 #include "app/study.hpp"
 
@@ -42,28 +43,6 @@ std::string short_number(double v) {
   return s.str();
 }
 
-// Replaces `final_dir` by `tmp` (an older folder is moved aside first and deleted afterwards).
-void publish(const fs::path& tmp, const fs::path& final_dir) {
-  std::string old_name = ".";
-  old_name += final_dir.filename().string();
-  old_name += ".old-";
-  old_name += std::to_string(static_cast<long>(::getpid()));
-  const fs::path old = final_dir.parent_path() / old_name;
-  std::error_code ec;
-  const bool replacing = fs::exists(fs::symlink_status(final_dir));
-  if (replacing) {
-    fs::remove_all(old, ec);
-    fs::rename(final_dir, old);
-  }
-  try {
-    fs::rename(tmp, final_dir);
-  } catch (...) {
-    if (replacing) fs::rename(old, final_dir, ec);
-    throw;
-  }
-  if (replacing) fs::remove_all(old, ec);
-}
-
 }  // namespace
 
 int run_stability_study(const StudyOptions& options) {
@@ -73,10 +52,7 @@ int run_stability_study(const StudyOptions& options) {
   std::vector<fs::path> created;  // output-root folders this run made (removed again on failure)
   std::error_code ec;
   try {
-    for (fs::path p = options.out_root; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
-      created.push_back(p);
-      if (p == p.parent_path()) break;
-    }
+    created = missing_folders(options.out_root);
     const std::vector<StabilityCase> cases = stability_cases(options.quick);
     fs::create_directories(options.out_root);
     fs::remove_all(tmp);
@@ -111,7 +87,7 @@ int run_stability_study(const StudyOptions& options) {
       log_line("drawing the heat map (scripts/plot_stability.py)");
       plot_error = run_plot_script("plot_stability.py", {(tmp / "results.csv").string(), (tmp / "heatmap.png").string()});
     }
-    publish(tmp, final_dir);
+    if (const std::string warning = replace_folder(tmp, final_dir); !warning.empty()) log_line("warning: " + warning);
 
     std::vector<std::string> failed;
     for (const StabilityResult& r : results)
