@@ -11,6 +11,19 @@
 
 namespace {
 
+// Parses argv into `app`. Returns -1 to go on, otherwise the exit code (0 after --help, 1 after
+// printing a usage error).
+int parse(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::cerr << "clothsim: error: " << e.what() << "\nRun with --help for usage.\n";
+    return 1;
+  }
+  return -1;
+}
+
 // `clothsim render DIR [--size WxH]`.
 int render_command(int argc, char** argv) {
   CLI::App app{"clothsim render: draw the saved frames DIR/frames/mesh_*.obj of a dynamic run again into\n"
@@ -19,13 +32,7 @@ int render_command(int argc, char** argv) {
   std::string dir, size;
   app.add_option("dir", dir, "Output folder of a run (with frames/mesh_*.obj)")->required()->type_name("DIR");
   app.add_option("--size", size, "Image size, e.g. 960x720")->type_name("WxH");
-  try {
-    app.parse(argc - 1, argv + 1);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "clothsim: error: " << e.what() << "\nRun with --help for usage.\n";
-    return 1;
-  }
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
   int width = 0, height = 0;
   if (!size.empty() && (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 ||
                         width > 8192 || height > 8192)) {
@@ -51,13 +58,7 @@ int study_command(int argc, char** argv) {
   app.add_option("--out", out, "Output root; the report goes to DIR/study_<NAME>/")->type_name("DIR")->capture_default_str();
   app.add_flag("--quick", options.quick, "Run a small subset of the cases (seconds; used by the tests)");
   app.add_flag("--no-plot", no_plot, "Write the data but no PNG (no python3-matplotlib needed)");
-  try {
-    app.parse(argc - 1, argv + 1);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);
-    std::cerr << "clothsim: error: " << e.what() << "\nRun with --help for usage.\n";
-    return 1;
-  }
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
   options.out_root = out;
   options.plot = !no_plot;
   return which == "convergence" ? clothsim::run_convergence_study(options) : clothsim::run_stability_study(options);
@@ -93,13 +94,7 @@ int main(int argc, char** argv) {
   CLI::Option* frames_option =
       app.add_option("--frames", frames, "Dynamic scenes: simulate just long enough for N frames")->type_name("N");
   app.add_option("--size", size, "Image size, e.g. 960x720 (replaces render.width/height)")->type_name("WxH");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    if (e.get_exit_code() == 0) return app.exit(e);  // --help
-    std::cerr << "clothsim: error: " << e.what() << "\nRun with --help for usage.\n";
-    return 1;
-  }
+  if (const int code = parse(app, argc, argv); code >= 0) return code;
   clothsim::RunOptions options;
   if (end_option->count() > 0) options.end = end;
   options.render = !no_render;
