@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <fstream>
+#include <stdexcept>
 #include <system_error>
 
 namespace clothsim {
@@ -15,6 +17,13 @@ std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& 
     if (p == p.parent_path()) break;
   }
   return missing;
+}
+
+void write_text_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  out.close();
+  if (!out) throw std::runtime_error(path.string() + ": cannot write the file");
 }
 
 std::string replace_folder(const std::filesystem::path& staging, const std::filesystem::path& target) {

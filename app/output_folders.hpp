@@ -1,4 +1,4 @@
-// Small filesystem helpers shared by the static and dynamic runs.
+// Small filesystem helpers shared by the static and dynamic runs and the studies.
 #pragma once
 
 #include <filesystem>
@@ -10,6 +10,10 @@ namespace clothsim {
 // The missing ancestors of `dir` (deepest first), i.e. the folders create_directories(dir)
 // would make; used to remove exactly those again when a run fails.
 std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& dir);
+
+// Writes `text` to `path` (binary, replacing the file); throws std::runtime_error naming the path
+// when the file cannot be written.
+void write_text_file(const std::filesystem::path& path, const std::string& text);
 
 // Renames the finished folder `staging` to `target`, replacing an older `target` only once the
 // new one is in place: the old one is moved aside to a hidden sibling (".<name>.old-<pid>"),

@@ -58,13 +58,6 @@ std::string result_json(const Scene& scene, const StaticResult& result) {
   return out.dump(2) + "\n";
 }
 
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(path.string() + ": cannot write file");
-}
-
 // Runs `write(tmp)` on a fresh folder `root/.<name>.tmp-<pid>`, then renames it to `root/<name>`
 // (replacing an older one). On failure removes everything it created, including `root` itself
 // if it did not exist before, and rethrows.
@@ -181,7 +174,7 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     }
     try {
       publish(out_root, scene.name, [&](const fs::path& dir) {
-        write_text(dir / "result.json", json);
+        write_text_file(dir / "result.json", json);
         write_obj((dir / "limit.obj").string(), deformed, scene.problem.mesh.triangles, comment);
         if (picture) render::write_png((dir / "limit.png").string(), *picture);
       });

@@ -18,6 +18,7 @@
 #include <fstream>
 #include <iostream>
 #include <stdexcept>
+#include <sstream>
 #include <string>
 
 #ifndef CLOTHSIM_SOURCE_DIR
@@ -30,13 +31,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void write_text_file(const fs::path& path, const std::string& what, void (*write)(std::ostream&, const std::vector<ConvergenceRow>&),
-                     const std::vector<ConvergenceRow>& rows) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error("cannot write " + path.string() + " (" + what + ")");
+// The text `write` produces for `rows`.
+std::string text_of(void (*write)(std::ostream&, const std::vector<ConvergenceRow>&), const std::vector<ConvergenceRow>& rows) {
+  std::ostringstream out;
   write(out, rows);
-  out.flush();
-  if (!out) throw std::runtime_error("writing " + path.string() + " failed");
+  return out.str();
 }
 
 }  // namespace
@@ -58,8 +57,8 @@ int run_convergence_study(const StudyOptions& options) {
     fs::remove_all(staging);
     fs::create_directory(staging);
     const fs::path csv = staging / "results.csv";
-    write_text_file(csv, "results table", write_results_csv, rows);
-    write_text_file(staging / "results.md", "Markdown table", write_results_markdown, rows);
+    write_text_file(csv, text_of(write_results_csv, rows));
+    write_text_file(staging / "results.md", text_of(write_results_markdown, rows));
 
     std::string plot_error;
     if (options.plot)

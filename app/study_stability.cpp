@@ -8,6 +8,7 @@
 #include "app/plotting.hpp"
 #include "app/study.hpp"
 
+#include "sim/study/report_format.hpp"
 #include "sim/study/stability.hpp"
 
 #include <unistd.h>
@@ -30,18 +31,7 @@ namespace fs = std::filesystem;
 
 void log_line(const std::string& line) { std::cerr << "clothsim: " << line << std::endl; }
 
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  out.close();
-  if (!out) throw std::runtime_error(path.string() + ": cannot write the file");
-}
-
-std::string short_number(double v) {
-  std::ostringstream s;
-  s << std::setprecision(3) << v;
-  return s.str();
-}
+std::string short_number(double v) { return format_significant(v, 3); }
 
 }  // namespace
 
@@ -63,7 +53,7 @@ int run_stability_study(const StudyOptions& options) {
     std::vector<StabilityResult> results;
     for (size_t i = 0; i < cases.size(); ++i) {
       const StabilityCase& c = cases[i];
-      write_text(tmp / "scenes" / (c.name + ".json"), c.scene_json);
+      write_text_file(tmp / "scenes" / (c.name + ".json"), c.scene_json);
       std::string tag = "[";
       tag += std::to_string(i + 1);
       tag += '/';
@@ -79,8 +69,8 @@ int run_stability_study(const StudyOptions& options) {
       results.push_back(std::move(r));
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    write_text(tmp / "results.csv", stability_csv(results));
-    write_text(tmp / "table.md", stability_markdown(results, wall));
+    write_text_file(tmp / "results.csv", stability_csv(results));
+    write_text_file(tmp / "table.md", stability_markdown(results, wall));
 
     std::string plot_error;
     if (options.plot) {

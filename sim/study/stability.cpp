@@ -2,6 +2,7 @@
 
 #include "sim/dynamics/simulator.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/study/report_format.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -229,11 +230,7 @@ namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
-std::string short_number(double v) {
-  std::ostringstream s;
-  s << std::setprecision(3) << v;
-  return s.str();
-}
+std::string short_number(double v) { return format_significant(v, 3); }
 
 // Runs the scene `json` of case `name` to its end or its failure, recording the figures into r;
 // progress lines are prefixed with `label`.
@@ -332,31 +329,12 @@ void judge(StabilityResult& r) {
 
 namespace {
 
-std::string number(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), v);
-  return std::string(buffer, result.ptr);
-}
-
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += (c == '"') ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
+std::string number(double v) { return format_shortest(v); }
 
 std::string join(const std::vector<std::string>& parts, const std::string& separator) {
   std::string out;
   for (size_t i = 0; i < parts.size(); ++i) out += (i ? separator : "") + parts[i];
   return out;
-}
-
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
 }
 
 std::string scientific(double v) {
@@ -365,12 +343,6 @@ std::string scientific(double v) {
   std::ostringstream s;
   s << std::scientific << std::setprecision(1) << v;
   return s.str();
-}
-
-std::string markdown_cell(std::string s) {
-  std::string out;
-  for (char c : s) out += c == '|' ? std::string("\\|") : std::string(1, c);
-  return out;
 }
 
 }  // namespace
@@ -386,7 +358,7 @@ std::string stability_csv(const std::vector<StabilityResult>& results) {
         << ',' << r.verdict() << ',' << csv_field(r.group) << ',' << r.vertices << ',' << number(r.dt) << ','
         << r.steps << ',' << r.planned_steps << ',' << number(r.energy_scale) << ',' << number(r.limits.energy_rise)
         << ',' << number(r.limits.strain) << ',' << number(r.tolerance) << ',' << r.iteration_limit << ','
-        << fixed(r.wall_seconds, 2) << ',' << csv_field(join(r.failures, "; ")) << ',' << csv_field(r.remedy) << ','
+        << format_fixed(r.wall_seconds, 2) << ',' << csv_field(join(r.failures, "; ")) << ',' << csv_field(r.remedy) << ','
         << csv_field(r.without_remedy) << ',' << csv_field(r.error) << '\n';
   }
   return out.str();
@@ -398,7 +370,7 @@ std::string stability_markdown(const std::vector<StabilityResult>& results, doub
   for (const StabilityResult& r : results) passed += r.pass ? 1 : 0;
   const StabilityLimits limits = results.empty() ? StabilityLimits() : results.front().limits;
   out << "# Stability study\n\n"
-      << passed << " of " << results.size() << " cases pass; total wall time " << fixed(total_wall_seconds, 1)
+      << passed << " of " << results.size() << " cases pass; total wall time " << format_fixed(total_wall_seconds, 1)
       << " s. The cases, the figures and the criteria are described in docs/stability.md; each case's scene is in "
          "scenes/<case>.json.\n\n"
       << "| case | verdict | vertices | dt [s] | steps | energy rise | max strain | max iterations | residual | wall [s] "
@@ -408,7 +380,7 @@ std::string stability_markdown(const std::vector<StabilityResult>& results, doub
     out << "| `" << r.name << "` | " << (r.pass ? "pass" : "**fail**: " + markdown_cell(join(r.failures, "; "))) << " | "
         << r.vertices << " | " << number(r.dt) << " | " << r.steps << "/" << r.planned_steps << " | "
         << scientific(r.energy_rise) << " | " << scientific(r.max_strain) << " | " << r.max_iterations << " | "
-        << scientific(r.residual) << " | " << fixed(r.wall_seconds, 1) << " | "
+        << scientific(r.residual) << " | " << format_fixed(r.wall_seconds, 1) << " | "
         << markdown_cell(r.remedy.empty() ? "–" : r.remedy) << " | "
         << markdown_cell(r.without_remedy.empty() ? "–" : r.without_remedy) << " |\n";
   }
