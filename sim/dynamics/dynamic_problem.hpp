@@ -41,7 +41,7 @@ struct SolverSettings {
   int max_iterations = 2000;  // pcg
   int newton_iterations = 1;  // linear solves per step; > 1 re-extracts rotations (accuracy studies)
   PreconditionerType preconditioner = PreconditionerType::block_jacobi;  // pcg
-  int refresh_iterations = 20;  // cholesky preconditioner: refactor after a solve that needed more
+  int refresh_iterations = 50;  // cholesky preconditioner: refactor after a solve that needed more
   bool tension_stiffening = true;  // membrane geometric stiffness in the matrix (corotation.hpp)
 };
 
@@ -79,7 +79,9 @@ struct StepStats {
   double newton_change = 0.0;    // ‖v⁺_k − v⁺_{k−1}‖ / ‖v⁺_k‖ of the last Newton iteration (0 with one)
   double rotate_ms = 0.0;        // rotation extraction
   double assemble_ms = 0.0;      // rotated stiffness, forces, system matrix
-  double solve_ms = 0.0;         // linear solve
+  double solve_ms = 0.0;         // linear solve (with any factorisation)
+  int factorizations = 0;        // Cholesky factorisations in this step (direct solve or preconditioner)
+  double factor_ms = 0.0;        // their time, part of solve_ms
   double kinetic_energy = 0.0;   // ½ vᵀ M v [J]
   double elastic_energy = 0.0;   // corotated strain energy [J]
   double external_work = 0.0;    // work of the external loads on the free components this step [J]

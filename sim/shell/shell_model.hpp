@@ -68,6 +68,8 @@ class ShellModel {
   // Building blocks for other assemblies (the corotational dynamics):
   // the zero-valued matrix with the stiffness pattern (3·#V square);
   Eigen::SparseMatrix<double> zero_matrix() const { return pattern_; }
+  // that pattern itself (to check or refill a matrix without copying it);
+  const Eigen::SparseMatrix<double>& pattern() const { return pattern_; }
   // the rest stiffness of element e in patch coordinates (3·#patch square, not folded);
   Eigen::MatrixXd patch_stiffness(int e) const;
   // the element's patch displacements (3·#patch) from real displacements (3·#V);
@@ -84,6 +86,10 @@ class ShellModel {
     for (int d = 0; d < 3; ++d)
       for (int c = 0; c < 3; ++c) target[d * stride + c] += block(c, d);
   }
+  // the value offsets of element e's blocks (a, b) at [a + m·b], m = #real (as add_block), and
+  // the entries in one column of vertex v's block column (the stride between a block's columns);
+  const int* block_slots(int e) const { return slots_[e].data(); }
+  int block_stride(int v) const { return block_stride_[v]; }
   // folds a patch-coordinate vector into a global vector.
   void add_patch_vector(int e, const Eigen::VectorXd& f_patch, Eigen::VectorXd& global) const {
     scatter_vector(elements_[e], f_patch, global);
