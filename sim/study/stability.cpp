@@ -110,6 +110,7 @@ struct Remedy {
   std::string text;                  // e.g. "newton_iterations = 2 (...)"
   std::function<void(Json&)> apply;  // sets them in a scene
   bool needed = true;                // needed to pass (the case also runs without it), or speed only
+  bool systematic = true;            // without it the case fails whatever the round-off
 };
 
 struct Builder {
@@ -127,6 +128,7 @@ struct Builder {
     StabilityCase c{name, group, description, "", remedy.text, "", quick};
     if (remedy.apply) {
       if (remedy.needed) c.without_remedy_json = s.dump(2) + "\n";
+      c.fails_without_remedy = remedy.needed && remedy.systematic;
       remedy.apply(s);
       s["description"] = s["description"].get<std::string>() + " Solver settings beyond the base: " + remedy.text + ".";
     }
@@ -145,8 +147,8 @@ std::vector<StabilityCase> stability_cases(bool quick_only) {
       [](Json& s) { set_newton(s, 2); set_cholesky(s); }};
   const Remedy snap_newton{
       "newton_iterations = 2 (the stiff sleeve snaps into folds within one 10 ms step; one solve with the "
-      "rotations frozen overshoots)",
-      [](Json& s) { set_newton(s, 2); }};
+      "rotations frozen overshoots by an amount that depends on round-off)",
+      [](Json& s) { set_newton(s, 2); }, true, false};
   const Remedy twist_newton{
       "newton_iterations = 8 (the rim turns 36 deg per step: with the rotations frozen the elements next to it "
       "are torn to a strain of 2.3; the iteration converges slowly)",
@@ -175,7 +177,7 @@ std::vector<StabilityCase> stability_cases(bool quick_only) {
   b.add("nu_0.49", "poisson", "nu = 0.49", false, [](Json& s) { set_poisson(s, 0.49); });
   // Time step.
   b.add("dt_1e-4", "time step", "dt = 0.1 ms", false, [](Json& s) { set_dt(s, 1e-4); });
-  b.add("dt_1e-2", "time step", "dt = 10 ms", true, [](Json& s) { set_dt(s, 1e-2); });
+  b.add("dt_1e-2", "time step", "dt = 10 ms", true, [](Json& s) { set_dt(s, 1e-2); }, snap_newton);
   b.add("dt_5e-2", "time step", "dt = 50 ms", true, [](Json& s) { set_dt(s, 5e-2); });
   // Twist of the bottom rim (over 1 s).
   b.add("twist_180", "twist", "bottom rim turned 180 deg in 1 s", false, [](Json& s) { set_twist(s, 180, 1.0); });
