@@ -1,5 +1,7 @@
 #include "sim/solver/cholesky_preconditioner.hpp"
 
+#include "sim/solver/supernodal_kernels.hpp"
+
 #include <Eigen/CholmodSupport>
 
 #include <cholmod.h>
@@ -10,11 +12,17 @@
 
 namespace clothsim {
 
+bool supernodal_avx2::supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+
 struct CholeskyPreconditioner::Impl {
   cholmod_common common{};
   cholmod_factor* factor = nullptr;
   bool ready = false;
   double flops = 0.0;
+  bool avx2 = false;
   // The supernodal structure (copied once after the analysis) and the values in single precision.
   // Supernode s holds columns super[s] … super[s+1]−1 of L as a dense column-major block with
   // rows[row_start[s]] … rows[row_start[s+1]−1] (the first of them the diagonal block), whose
@@ -50,7 +58,9 @@ struct CholeskyPreconditioner::Impl {
   }
 };
 
-CholeskyPreconditioner::CholeskyPreconditioner() : impl_(std::make_unique<Impl>()) {}
+CholeskyPreconditioner::CholeskyPreconditioner(bool vector_kernels) : impl_(std::make_unique<Impl>()) {
+  impl_->avx2 = vector_kernels && supernodal_avx2::supported();
+}
 CholeskyPreconditioner::~CholeskyPreconditioner() = default;
 
 bool CholeskyPreconditioner::ready() const { return impl_->ready; }
@@ -165,13 +175,17 @@ using Block = Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>;
 void CholeskyPreconditioner::Impl::forward(int first, int last, float* y, float* top_rows, float* gather) const {
   for (int s = first; s <= last; ++s) {
     const int col0 = super[s], cols = super[s + 1] - col0, height = row_start[s + 1] - row_start[s];
-    const Block block(values.data() + value_start[s], height, cols, Eigen::OuterStride<>(height));
-    Eigen::Map<Eigen::VectorXf> ys(y + col0, cols);
-    block.topRows(cols).triangularView<Eigen::Lower>().solveInPlace(ys);
     const int below = height - cols;
+    if (avx2) {
+      supernodal_avx2::forward(values.data() + value_start[s], height, cols, y + col0, gather);
+    } else {
+      const Block block(values.data() + value_start[s], height, cols, Eigen::OuterStride<>(height));
+      Eigen::Map<Eigen::VectorXf> ys(y + col0, cols);
+      block.topRows(cols).triangularView<Eigen::Lower>().solveInPlace(ys);
+      if (below > 0) Eigen::Map<Eigen::VectorXf>(gather, below).noalias() = block.bottomRows(below) * ys;
+    }
     if (below == 0) continue;
-    Eigen::Map<Eigen::VectorXf> update(gather, below);
-    update.noalias() = block.bottomRows(below) * ys;
+    const float* update = gather;
     const int* r = rows.data() + row_start[s] + cols;
     for (int i = 0; i < below; ++i) {
       if (top_rows && r[i] >= top_first_column)
@@ -185,15 +199,16 @@ void CholeskyPreconditioner::Impl::forward(int first, int last, float* y, float*
 void CholeskyPreconditioner::Impl::backward(int first, int last, float* y, float* gather) const {
   for (int s = last; s >= first; --s) {
     const int col0 = super[s], cols = super[s + 1] - col0, height = row_start[s + 1] - row_start[s];
+    const int below = height - cols;
+    const int* r = rows.data() + row_start[s] + cols;
+    for (int i = 0; i < below; ++i) gather[i] = y[r[i]];
+    if (avx2) {
+      supernodal_avx2::backward(values.data() + value_start[s], height, cols, y + col0, gather);
+      continue;
+    }
     const Block block(values.data() + value_start[s], height, cols, Eigen::OuterStride<>(height));
     Eigen::Map<Eigen::VectorXf> ys(y + col0, cols);
-    const int below = height - cols;
-    if (below > 0) {
-      const int* r = rows.data() + row_start[s] + cols;
-      Eigen::Map<Eigen::VectorXf> known(gather, below);
-      for (int i = 0; i < below; ++i) known[i] = y[r[i]];
-      ys.noalias() -= block.bottomRows(below).transpose() * known;
-    }
+    if (below > 0) ys.noalias() -= block.bottomRows(below).transpose() * Eigen::Map<const Eigen::VectorXf>(gather, below);
     block.topRows(cols).transpose().triangularView<Eigen::Upper>().solveInPlace(ys);
   }
 }

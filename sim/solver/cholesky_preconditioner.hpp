@@ -18,7 +18,9 @@ namespace clothsim {
 
 class CholeskyPreconditioner {
  public:
-  CholeskyPreconditioner();
+  // `vector_kernels`: use the AVX2 + FMA kernels where the processor has them (false: the
+  // portable Eigen ones, for comparison).
+  explicit CholeskyPreconditioner(bool vector_kernels = true);
   ~CholeskyPreconditioner();
   CholeskyPreconditioner(const CholeskyPreconditioner&) = delete;
   CholeskyPreconditioner& operator=(const CholeskyPreconditioner&) = delete;

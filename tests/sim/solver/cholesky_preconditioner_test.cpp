@@ -18,9 +18,12 @@ Eigen::SparseMatrix<double> plate_matrix(int divisions) {
   return k;
 }
 
-TEST(CholeskyPreconditioner, MatchesTheDoublePrecisionSolve) {
+class CholeskyPreconditionerKernels : public ::testing::TestWithParam<bool> {};
+
+// Both kernel sets: the AVX2 + FMA ones (where the processor has them) and the portable ones.
+TEST_P(CholeskyPreconditionerKernels, MatchesTheDoublePrecisionSolve) {
   const Eigen::SparseMatrix<double> a = plate_matrix(24);
-  CholeskyPreconditioner pre;
+  CholeskyPreconditioner pre(GetParam());
   EXPECT_FALSE(pre.ready());
   ASSERT_TRUE(pre.factorize(a));
   EXPECT_TRUE(pre.ready());
@@ -35,6 +38,9 @@ TEST(CholeskyPreconditioner, MatchesTheDoublePrecisionSolve) {
   EXPECT_LT((z - exact).norm(), 1e-4 * exact.norm());  // single precision, not a coincidence
   EXPECT_GT((z - exact).norm(), 0.0);
 }
+
+INSTANTIATE_TEST_SUITE_P(Kernels, CholeskyPreconditionerKernels, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& p) { return p.param ? "vector" : "portable"; });
 
 TEST(CholeskyPreconditioner, RefactorisesWithTheSamePattern) {
   const Eigen::SparseMatrix<double> a = plate_matrix(16);

@@ -1,0 +1,20 @@
+// Dense kernels of the single-precision supernodal triangular solves (CholeskyPreconditioner),
+// compiled for AVX2 + FMA in their own translation unit and chosen at run time where the processor
+// has them. The unit uses raw pointers and intrinsics only (no Eigen, no standard-library
+// templates), so no inline function is compiled twice with different instruction sets.
+//
+// A supernode's block is column-major, `height` rows by `cols` columns, leading dimension
+// `height`; its first `cols` rows hold the lower-triangular diagonal block.
+#pragma once
+
+namespace clothsim::supernodal_avx2 {
+
+// Whether this processor can run the kernels below (defined in cholesky_preconditioner.cpp, which
+// is compiled for the baseline instruction set).
+bool supported();
+// Forward step: ys ← D⁻¹ ys (D the diagonal block), below ← (rows under D) · ys.
+void forward(const float* block, int height, int cols, float* ys, float* below);
+// Backward step: ys ← D⁻ᵀ (ys − (rows under D)ᵀ · known).
+void backward(const float* block, int height, int cols, float* ys, const float* known);
+
+}  // namespace clothsim::supernodal_avx2
