@@ -325,9 +325,10 @@ StepStats Simulator::step() {
         // than the average per solve since the last factorisation, the factorisation included
         // (for a cost that grows steadily this minimises the long-run average), or when it
         // exceeded refresh_iterations. The factorisation's cost in iterations is estimated from
-        // its flop count against the bytes of one iteration (factor solves and a product with A),
-        // scaled by the measured ratio of the two speeds (factorisation 85 ms ≙ 61 iterations of
-        // 1.4 ms on the 2542-vertex sleeve, 2 cores). Decided on counts, never on timings: runs
+        // its flop count against the flops of one iteration (two triangular solves and a product
+        // with A), scaled by 0.47, the ratio of the two speeds measured when this was written
+        // (factorisation 85 ms ≙ 61 iterations of 1.4 ms on the 2542-vertex sleeve, 2 cores; the
+        // optimum is flat, see docs/performance.md). Decided on counts, never on timings: runs
         // are repeatable.
         ++m.solves_since_factor;
         m.iterations_since_factor += r.iterations;
