@@ -174,7 +174,7 @@ class Outputs {
   Outputs(const Scene& scene, const fs::path& dir, const LimitSurfaceDrawer* drawer)
       : scene_(scene), dir_(dir), drawer_(drawer), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
     probes_.line("step,t,name,ux,uy,uz");
-    stats_.line("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work");
+    stats_.line("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms");
     probes_.flush();
     stats_.flush();
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
@@ -242,7 +242,7 @@ class Outputs {
          {format_double(s.t), std::to_string(s.solver_iterations), format_double(s.residual),
           format_double(s.rotate_ms), format_double(s.assemble_ms), format_double(s.solve_ms),
           format_double(s.kinetic_energy), format_double(s.elastic_energy), format_double(s.external_work),
-          format_double(s.boundary_work)})
+          format_double(s.boundary_work), std::to_string(s.factorizations), format_double(s.factor_ms)})
       row.append(1, ',').append(field);
     stats_.line(row);
     stats_.flush();

@@ -81,6 +81,7 @@ struct Simulator::Impl {
   // When to refresh `factor` (counted in conjugate-gradient iterations, see step()).
   int solves_since_factor = 0;
   double iterations_since_factor = 0.0;
+  bool refactor_next = false;
   DynamicState state;
   Eigen::MatrixX3d limit_rest;
   double work = 0.0;           // external_work()
@@ -137,8 +138,9 @@ Simulator::Simulator(const DynamicProblem& problem) {
 
   // Which components the linear solve treats as unknown.
   static const std::vector<Motion> kHold;
+  // (Pointers into the simulator's own copy of the problem: the caller's may not outlive it.)
   std::vector<const std::vector<Motion>*> motion_of(3 * n, nullptr);
-  for (const BoundaryCondition& bc : problem.boundary)
+  for (const BoundaryCondition& bc : m.problem.boundary)
     for (int v : bc.vertices)
       for (int c = 0; c < 3; ++c)
         if (bc.fix[c]) motion_of[3 * v + c] = &bc.motion;
@@ -314,7 +316,10 @@ StepStats Simulator::step() {
     };
     if (p.solver.type == LinearSolverType::pcg) {
       const bool cholesky = p.solver.preconditioner == PreconditionerType::cholesky;
-      if (cholesky && !m.factor.ready()) refactor();
+      if (cholesky && (!m.factor.ready() || m.refactor_next)) {
+        m.refactor_next = false;
+        refactor();
+      }
       const Preconditioner factor = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor.apply(r, z); };
       const Eigen::VectorXd start = v_next;
       PcgResult r = solve_pcg(a, b, m.solve_free, v_next, p.solver.tolerance, p.solver.max_iterations,
@@ -324,24 +329,29 @@ StepStats Simulator::step() {
         // (about one more per step in the buckling sleeve). Refactor when this solve cost more
         // than the average per solve since the last factorisation, the factorisation included
         // (for a cost that grows steadily this minimises the long-run average), or when it
-        // exceeded refresh_iterations. The factorisation's cost in iterations is estimated from
-        // its flop count against the flops of one iteration (two triangular solves and a product
-        // with A), scaled by 0.47, the ratio of the two speeds measured when this was written
-        // (factorisation 85 ms ≙ 61 iterations of 1.4 ms on the 2542-vertex sleeve, 2 cores; the
-        // optimum is flat, see docs/performance.md). Decided on counts, never on timings: runs
-        // are repeatable.
+        // exceeded refresh_iterations. The new factor is of the next step's matrix (taken at the
+        // start of that step), not of this one, which is solved already: a factor of the matrix
+        // being solved needs 3–4 iterations, one a step old 6–9 in the sleeve's slow phases and
+        // 15–70 while it snaps into folds. The factorisation's cost in iterations is estimated
+        // from its flop count against the flops of one iteration (two triangular solves and a
+        // product with A), scaled by 0.23, the ratio of the two speeds measured when this was
+        // written (factorisation 31 ms ≙ 28 iterations of 1.1 ms on the 2542-vertex sleeve, 2
+        // cores; the optimum is flat, see docs/performance.md). Decided on counts, never on
+        // timings: runs are repeatable.
         ++m.solves_since_factor;
         m.iterations_since_factor += r.iterations;
         const double iteration_work = 4.0 * static_cast<double>(m.factor.factor_entries()) + 2.0 * static_cast<double>(a.nonZeros());
-        const double factor_cost = 0.47 * m.factor.factor_flops() / std::max(iteration_work, 1.0);
+        const double factor_cost = 0.23 * m.factor.factor_flops() / std::max(iteration_work, 1.0);
         const bool pays = r.iterations * m.solves_since_factor > factor_cost + m.iterations_since_factor;
-        if (!r.converged || r.iterations > p.solver.refresh_iterations || pays) {
+        if (!r.converged) {  // refactor now and solve again from the same start
           refactor();
-          if (!r.converged && m.factor.ready()) {
+          if (m.factor.ready()) {
             stats.solver_iterations += r.iterations;
             v_next = start;
             r = solve_pcg(a, b, m.solve_free, v_next, p.solver.tolerance, p.solver.max_iterations, factor);
           }
+        } else if (r.iterations > p.solver.refresh_iterations || pays) {
+          m.refactor_next = true;
         }
       }
       stats.solver_iterations += r.iterations;

@@ -5,12 +5,61 @@
 #include <Eigen/CholmodSupport>
 
 #include <cholmod.h>
+#include <dlfcn.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <cstddef>
 #include <vector>
 
+// Single-precision BLAS and LAPACK (Fortran interface; the trailing arguments are the lengths of
+// the character arguments, as gfortran passes them).
+extern "C" {
+void sgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const float* alpha,
+            const float* a, const int* lda, const float* b, const int* ldb, const float* beta, float* c, const int* ldc,
+            std::size_t, std::size_t);
+void ssyrk_(const char* uplo, const char* trans, const int* n, const int* k, const float* alpha, const float* a,
+            const int* lda, const float* beta, float* c, const int* ldc, std::size_t, std::size_t);
+void strsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
+            const float* alpha, const float* a, const int* lda, float* b, const int* ldb, std::size_t, std::size_t,
+            std::size_t, std::size_t);
+void spotrf_(const char* uplo, const int* n, float* a, const int* lda, int* info, std::size_t);
+}
+
 namespace clothsim {
+
+namespace {
+
+// OpenBLAS runs each call on all cores by default; the factorisation below calls it from threads
+// of its own (concurrent subtrees), so while it runs it asks for single-threaded calls where the
+// library offers the switch (found at run time: libblas.so.3 may be another implementation, which
+// is then left alone). OpenBLAS's own threads would compete for the same cores and spin.
+class SingleThreadedBlas {
+ public:
+  SingleThreadedBlas() {
+    static const auto get = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+    set_ = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+    if (get && set_) {
+      previous_ = get();
+      if (previous_ > 1) set_(1);
+    }
+  }
+  ~SingleThreadedBlas() {
+    if (set_ && previous_ > 1) set_(previous_);
+  }
+  SingleThreadedBlas(const SingleThreadedBlas&) = delete;
+  SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
+
+ private:
+  void (*set_)(int) = nullptr;
+  int previous_ = 0;
+};
+
+}  // namespace
 
 bool supernodal_avx2::supported() {
   __builtin_cpu_init();
@@ -23,6 +72,8 @@ struct CholeskyPreconditioner::Impl {
   bool ready = false;
   double flops = 0.0;
   bool avx2 = false;
+  bool single_precision = true;  // factorise in single precision (else: CHOLMOD in double, copied)
+  bool single = false;           // the current factor was computed in single precision
   // The supernodal structure (copied once after the analysis) and the values in single precision.
   // Supernode s holds columns super[s] … super[s+1]−1 of L as a dense column-major block with
   // rows[row_start[s]] … rows[row_start[s+1]−1] (the first of them the diagonal block), whose
@@ -39,6 +90,28 @@ struct CholeskyPreconditioner::Impl {
   int top_first_column = 0;                          // the top part's columns are the last ones
   mutable std::vector<float> work, gathered[2], top_update[2];
 
+  // Single-precision numeric factorisation on CHOLMOD's symbolic analysis (supernodal,
+  // left-looking): supernode s gathers its columns of P A Pᵀ, subtracts the updates of the
+  // supernodes below it (descendants d whose rows reach s's columns: L_d,rows≥s · L_d,rows∈sᵀ), then
+  // factorises its diagonal block and solves for the rows under it. Disjoint subtrees of the
+  // supernodal elimination tree do not touch each other's blocks and run concurrently; within a
+  // supernode the order of operations is fixed, so the result does not depend on the schedule.
+  std::vector<int> tree_parent, tree_child_start, tree_children;  // supernodal elimination tree (CSR children)
+  std::vector<int> update_start;                       // updates of s: [update_start[s], update_start[s+1])
+  std::vector<int> update_from, update_first, update_end;  // d, first row of d at/after s's columns, first after them
+  std::vector<int> gather_start;                       // entries of A gathered into s (CSR)
+  std::vector<long> gather_src, gather_dst;            // A's value index → values index
+  long a_nonzeros = -1;
+  std::vector<double> subtree_flops;
+  struct Scratch {
+    std::vector<int> local;      // row → position in the current supernode
+    std::vector<float> update;   // one descendant's update block
+  };
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  void plan_numeric(const Eigen::SparseMatrix<double>& a);
+  bool numeric_supernode(int s, const double* a_values);
+  bool numeric_subtree(int s, const double* a_values);
+  bool numeric(const Eigen::SparseMatrix<double>& a);
   void plan_split();
   void forward(int first, int last, float* y, float* top_rows, float* gather) const;
   void backward(int first, int last, float* y, float* gather) const;
@@ -58,12 +131,15 @@ struct CholeskyPreconditioner::Impl {
   }
 };
 
-CholeskyPreconditioner::CholeskyPreconditioner(bool vector_kernels) : impl_(std::make_unique<Impl>()) {
+CholeskyPreconditioner::CholeskyPreconditioner(bool vector_kernels, bool single_precision_factorization)
+    : impl_(std::make_unique<Impl>()) {
   impl_->avx2 = vector_kernels && supernodal_avx2::supported();
+  impl_->single_precision = single_precision_factorization;
 }
 CholeskyPreconditioner::~CholeskyPreconditioner() = default;
 
 bool CholeskyPreconditioner::ready() const { return impl_->ready; }
+bool CholeskyPreconditioner::factored_in_single_precision() const { return impl_->ready && impl_->single; }
 long CholeskyPreconditioner::factor_entries() const { return impl_->ready ? static_cast<long>(impl_->values.size()) : 0; }
 double CholeskyPreconditioner::factor_flops() const { return impl_->ready ? impl_->flops : 0.0; }
 
@@ -78,15 +154,13 @@ bool CholeskyPreconditioner::factorize(const Eigen::SparseMatrix<double>& a) {
     if (!m.factor) return false;
     m.flops = m.common.fl;
   }
-  if (!cholmod_factorize(&view, m.factor, &m.common) || m.common.status != CHOLMOD_OK || !m.factor->is_super ||
-      !m.factor->is_ll || m.factor->minor < m.factor->n)
-    return false;
   const cholmod_factor& l = *m.factor;
-  const auto* super = static_cast<const int*>(l.super);
-  const auto* pi = static_cast<const int*>(l.pi);
-  const auto* px = static_cast<const int*>(l.px);
   if (m.super.empty()) {
+    if (!l.is_super) return false;
     const auto nsuper = static_cast<size_t>(l.nsuper);
+    const auto* super = static_cast<const int*>(l.super);
+    const auto* pi = static_cast<const int*>(l.pi);
+    const auto* px = static_cast<const int*>(l.px);
     m.super.assign(super, super + nsuper + 1);
     m.row_start.assign(pi, pi + nsuper + 1);
     m.value_start.assign(px, px + nsuper + 1);
@@ -95,11 +169,155 @@ bool CholeskyPreconditioner::factorize(const Eigen::SparseMatrix<double>& a) {
     m.work.resize(l.n);
     for (int g = 0; g < 2; ++g) m.gathered[g].resize(l.n);
     m.plan_split();
+    m.plan_numeric(a);
   }
+  m.single = m.single_precision && a.nonZeros() == m.a_nonzeros && m.numeric(a);
+  if (m.single) {
+    m.ready = true;
+    return true;
+  }
+  // CHOLMOD in double precision: without the single-precision option, or where it met a pivot
+  // that is not positive (a matrix too ill-conditioned for single precision).
+  if (!cholmod_factorize(&view, m.factor, &m.common) || m.common.status != CHOLMOD_OK || !m.factor->is_super ||
+      !m.factor->is_ll || m.factor->minor < m.factor->n)
+    return false;
   const auto* x = static_cast<const double*>(l.x);
   m.values.assign(x, x + m.value_start.back());
   m.ready = true;
   return true;
+}
+
+void CholeskyPreconditioner::Impl::plan_numeric(const Eigen::SparseMatrix<double>& a) {
+  const int nsuper = static_cast<int>(super.size()) - 1;
+  const int n = static_cast<int>(perm.size());
+  std::vector<int> owner(n), pinv(n);
+  for (int k = 0; k < n; ++k) pinv[perm[k]] = k;
+  for (int s = 0; s < nsuper; ++s)
+    for (int k = super[s]; k < super[s + 1]; ++k) owner[k] = s;
+  tree_parent.assign(nsuper, -1);
+  std::vector<std::vector<int>> kids(nsuper);
+  std::vector<std::vector<std::array<int, 3>>> lists(nsuper);
+  for (int d = 0; d < nsuper; ++d) {
+    const int cols = super[d + 1] - super[d];
+    const int begin = row_start[d] + cols, end = row_start[d + 1];
+    if (begin < end) {
+      tree_parent[d] = owner[rows[begin]];
+      kids[tree_parent[d]].push_back(d);
+    }
+    for (int p = begin; p < end;) {
+      const int s = owner[rows[p]];
+      int q = p;
+      while (q < end && rows[q] < super[s + 1]) ++q;
+      lists[s].push_back({d, p, q});
+      p = q;
+    }
+  }
+  tree_child_start.assign(1, 0);
+  tree_children.clear();
+  update_start.assign(1, 0);
+  update_from.clear(), update_first.clear(), update_end.clear();
+  for (int s = 0; s < nsuper; ++s) {
+    tree_children.insert(tree_children.end(), kids[s].begin(), kids[s].end());
+    tree_child_start.push_back(static_cast<int>(tree_children.size()));
+    for (const auto& [d, p, q] : lists[s]) update_from.push_back(d), update_first.push_back(p), update_end.push_back(q);
+    update_start.push_back(static_cast<int>(update_from.size()));
+  }
+  // Work per subtree (for the split into concurrent tasks): the flops of its own updates and
+  // factorisation, approximately.
+  subtree_flops.assign(nsuper, 0.0);
+  for (int s = 0; s < nsuper; ++s) {
+    const double cols = super[s + 1] - super[s], height = row_start[s + 1] - row_start[s];
+    subtree_flops[s] += cols * cols * cols / 3.0 + (height - cols) * cols * cols;
+    for (int u = update_start[s]; u < update_start[s + 1]; ++u) {
+      const int d = update_from[u];
+      const double dcols = super[d + 1] - super[d];
+      subtree_flops[s] += 2.0 * dcols * (update_end[u] - update_first[u]) * (row_start[d + 1] - update_first[u]);
+    }
+    if (tree_parent[s] >= 0) subtree_flops[tree_parent[s]] += subtree_flops[s];
+  }
+  // Where each entry of A's lower triangle (in the permuted order) goes in the factor's blocks.
+  gather_start.assign(1, 0);
+  gather_src.clear(), gather_dst.clear();
+  std::vector<int> local(n, -1);
+  for (int s = 0; s < nsuper; ++s) {
+    const int height = row_start[s + 1] - row_start[s];
+    for (int p = row_start[s]; p < row_start[s + 1]; ++p) local[rows[p]] = p - row_start[s];
+    for (int k = super[s]; k < super[s + 1]; ++k) {
+      const int j = perm[k];
+      for (auto e = static_cast<long>(a.outerIndexPtr()[j]); e < a.outerIndexPtr()[j + 1]; ++e) {
+        const int i = pinv[a.innerIndexPtr()[e]];
+        if (i < k) continue;
+        gather_src.push_back(e);
+        gather_dst.push_back(value_start[s] + static_cast<long>(k - super[s]) * height + local[i]);
+      }
+    }
+    gather_start.push_back(static_cast<int>(gather_src.size()));
+  }
+  a_nonzeros = a.nonZeros();
+  values.assign(static_cast<size_t>(value_start.back()), 0.0f);
+}
+
+bool CholeskyPreconditioner::Impl::numeric_supernode(int s, const double* a_values) {
+  Scratch& tmp = scratch.local();
+  if (tmp.local.size() < perm.size()) tmp.local.assign(perm.size(), 0);
+  const int col0 = super[s], cols = super[s + 1] - col0, height = row_start[s + 1] - row_start[s];
+  float* block = values.data() + value_start[s];
+  std::fill(block, block + static_cast<long>(height) * cols, 0.0f);
+  for (int g = gather_start[s]; g < gather_start[s + 1]; ++g) values[gather_dst[g]] = static_cast<float>(a_values[gather_src[g]]);
+  for (int p = row_start[s]; p < row_start[s + 1]; ++p) tmp.local[rows[p]] = p - row_start[s];
+  const char lower = 'L', no = 'N', transpose = 'T', right = 'R';
+  const float one = 1.0f, zero = 0.0f;
+  for (int u = update_start[s]; u < update_start[s + 1]; ++u) {
+    const int d = update_from[u];
+    const int dcols = super[d + 1] - super[d], dheight = row_start[d + 1] - row_start[d];
+    const int first = update_first[u];
+    const int m1 = update_end[u] - first;        // d's rows among s's columns
+    const int m2 = row_start[d + 1] - first;     // d's rows from s's first column on
+    const float* x = values.data() + value_start[d] + (first - row_start[d]);
+    if (tmp.update.size() < static_cast<size_t>(m1) * m2) tmp.update.resize(static_cast<size_t>(m1) * m2);
+    float* w = tmp.update.data();
+    // W = X Xᵀ restricted to rows 0…m2 × columns 0…m1 (the top square's lower triangle only).
+    ssyrk_(&lower, &no, &m1, &dcols, &one, x, &dheight, &zero, w, &m2, 1, 1);
+    const int m3 = m2 - m1;
+    if (m3 > 0) sgemm_(&no, &transpose, &m3, &m1, &dcols, &one, x + m1, &dheight, x, &dheight, &zero, w + m1, &m2, 1, 1);
+    const int* r = rows.data() + first;
+    for (int j = 0; j < m1; ++j) {
+      float* target = block + static_cast<long>(r[j] - col0) * height;
+      const float* source = w + static_cast<long>(j) * m2;
+      for (int i = j; i < m2; ++i) target[tmp.local[r[i]]] -= source[i];
+    }
+  }
+  int info = 0;
+  spotrf_(&lower, &cols, block, &height, &info, 1);
+  if (info != 0) return false;
+  const int below = height - cols;
+  if (below > 0) strsm_(&right, &lower, &transpose, &no, &below, &cols, &one, block, &height, block + cols, &height, 1, 1, 1, 1);
+  return true;
+}
+
+bool CholeskyPreconditioner::Impl::numeric_subtree(int s, const double* a_values) {
+  // Children with much work run as tasks; the rest here.
+  bool ok = true;
+  const int first = tree_child_start[s], last = tree_child_start[s + 1];
+  if (last - first >= 2 && subtree_flops[s] > 2e6) {
+    std::vector<char> result(static_cast<size_t>(last - first), 1);
+    tbb::task_group group;
+    for (int c = first; c < last; ++c) group.run([&, c] { result[c - first] = numeric_subtree(tree_children[c], a_values); });
+    group.wait();
+    for (char r : result) ok = ok && r;
+  } else {
+    for (int c = first; c < last; ++c) ok = ok && numeric_subtree(tree_children[c], a_values);
+  }
+  return ok && numeric_supernode(s, a_values);
+}
+
+bool CholeskyPreconditioner::Impl::numeric(const Eigen::SparseMatrix<double>& a) {
+  const SingleThreadedBlas blas;
+  const int nsuper = static_cast<int>(super.size()) - 1;
+  bool ok = true;
+  for (int s = 0; s < nsuper; ++s)
+    if (tree_parent[s] < 0) ok = ok && numeric_subtree(s, a.valuePtr());
+  return ok;
 }
 
 void CholeskyPreconditioner::Impl::plan_split() {

@@ -282,11 +282,11 @@ TEST_F(CliTest, DynamicRunWritesOutputs) {
   // stats.csv: one row per step.
   const std::vector<std::string> stats = lines_of(read_text(dir / "stats.csv"));
   ASSERT_EQ(stats.size(), 11u);
-  EXPECT_EQ(stats[0], "step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work");
+  EXPECT_EQ(stats[0], "step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms");
   double work = 0.0;  // cumulative work of the loads and supports
   for (std::size_t i = 1; i < stats.size(); ++i) {
     const std::vector<std::string> f = split_csv(stats[i]);
-    ASSERT_EQ(f.size(), 11u) << stats[i];
+    ASSERT_EQ(f.size(), 13u) << stats[i];
     work += std::stod(f[9]) + std::stod(f[10]);
     EXPECT_EQ(std::stoi(f[0]), static_cast<int>(i));
     EXPECT_GE(std::stoi(f[2]), 1);
@@ -385,7 +385,7 @@ TEST_F(CliTest, DynamicRunFailureKeepsOutputs) {
   EXPECT_EQ(probes[1], "0,0,free_edge,0,0,0");
   const std::vector<std::string> stats = lines_of(read_text(dir / "stats.csv"));
   ASSERT_EQ(stats.size(), 1u + static_cast<std::size_t>(steps));
-  EXPECT_EQ(stats[0], "step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work");
+  EXPECT_EQ(stats[0], "step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms");
 }
 
 TEST_F(CliTest, FramesOptionSizeAndNoRender) {

@@ -10,6 +10,8 @@
 #include <Eigen/SVD>
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include <cmath>
 #include <random>
 
@@ -188,6 +190,37 @@ TEST(Dynamics, ScriptedVerticesFollowTheirMotionExactly) {
   const Eigen::Vector3d r = p.mesh.vertices.row(v);
   EXPECT_NEAR(sim.state().x(v, 0), -r(2) * 1.0 + 0.0 * r(0), 1e-12);
   EXPECT_NEAR(sim.state().x(v, 1), 0.2 - 0.03, 1e-12);
+}
+
+// The simulator keeps what it needs of the problem: scripted motions still drive the rim after
+// the caller's DynamicProblem is gone (they were once read through pointers into it).
+TEST(Dynamics, ScriptedMotionOutlivesTheCallersProblem) {
+  std::vector<int> top_vertices;
+  Eigen::MatrixX3d rest;
+  std::unique_ptr<Simulator> sim;
+  Motion push;
+  push.type = Motion::Type::translate;
+  push.displacement = Eigen::Vector3d(0, -0.03, 0);
+  push.start = 0.0;
+  push.end = 0.1;
+  {
+    auto p = std::make_unique<DynamicProblem>(free_sleeve(5000));
+    BoundaryCondition top;
+    for (int v = 0; v < p->mesh.num_vertices(); ++v)
+      if (p->mesh.vertices(v, 1) > 0.2 - 1e-9) top.vertices.push_back(v);
+    top.motion = {push};
+    p->boundary = {top};
+    p->time.end = 0.1;
+    top_vertices = top.vertices;
+    rest = p->mesh.vertices;
+    sim = std::make_unique<Simulator>(*p);
+    // Overwrite the freed problem's memory before it can be read again.
+    p->boundary[0].motion[0].displacement.setConstant(1e300);
+    p.reset();
+  }
+  for (int i = 0; i < sim->num_steps(); ++i) sim->step();
+  for (int v : top_vertices)
+    EXPECT_LT((sim->state().x.row(v) - rest.row(v) - push.displacement.transpose()).norm(), 1e-15) << "vertex " << v;
 }
 
 TEST(Corotation, RotationOfARigidlyRotatedAndStretchedFrame) {
