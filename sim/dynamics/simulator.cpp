@@ -306,9 +306,7 @@ StepStats Simulator::step() {
     };
     auto refactor = [&] {
       const auto f0 = std::chrono::steady_clock::now();
-      Eigen::SparseMatrix<double> copy = a;
-      dirichlet(copy, nullptr);
-      m.factor.factorize(copy);
+      m.factor.factorize(a, &m.solve_free);  // of the Dirichlet form
       ++stats.factorizations;
       stats.factor_ms += ms_since(f0);
       m.solves_since_factor = 0;
@@ -331,17 +329,17 @@ StepStats Simulator::step() {
         // (for a cost that grows steadily this minimises the long-run average), or when it
         // exceeded refresh_iterations. The new factor is of the next step's matrix (taken at the
         // start of that step), not of this one, which is solved already: a factor of the matrix
-        // being solved needs 3–4 iterations, one a step old 6–9 in the sleeve's slow phases and
+        // being solved needs 2 iterations, one a step old 6–9 in the sleeve's slow phases and
         // 15–70 while it snaps into folds. The factorisation's cost in iterations is estimated
         // from its flop count against the flops of one iteration (two triangular solves and a
-        // product with A), scaled by 0.23, the ratio of the two speeds measured when this was
-        // written (factorisation 31 ms ≙ 28 iterations of 1.1 ms on the 2542-vertex sleeve, 2
-        // cores; the optimum is flat, see docs/performance.md). Decided on counts, never on
-        // timings: runs are repeatable.
+        // product with A), scaled by 0.17, the ratio of the two speeds measured when this was
+        // written (factorisation 22 ms ≙ 21 iterations of 1.05 ms on the 2542-vertex sleeve, 2
+        // cores; the optimum is flat: 0.12 / 0.17 / 0.23 give 19.7 / 19.6 / 20.5 ms per step, see
+        // docs/performance.md). Decided on counts, never on timings: runs are repeatable.
         ++m.solves_since_factor;
         m.iterations_since_factor += r.iterations;
         const double iteration_work = 4.0 * static_cast<double>(m.factor.factor_entries()) + 2.0 * static_cast<double>(a.nonZeros());
-        const double factor_cost = 0.23 * m.factor.factor_flops() / std::max(iteration_work, 1.0);
+        const double factor_cost = 0.17 * m.factor.factor_flops() / std::max(iteration_work, 1.0);
         const bool pays = r.iterations * m.solves_since_factor > factor_cost + m.iterations_since_factor;
         if (!r.converged) {  // refactor now and solve again from the same start
           refactor();

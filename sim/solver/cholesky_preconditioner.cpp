@@ -8,6 +8,9 @@
 #include <dlfcn.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -101,6 +104,8 @@ struct CholeskyPreconditioner::Impl {
   std::vector<int> update_from, update_first, update_end;  // d, first row of d at/after s's columns, first after them
   std::vector<int> gather_start;                       // entries of A gathered into s (CSR)
   std::vector<long> gather_src, gather_dst;            // A's value index → values index
+  std::vector<int> gather_row, gather_col;             // A's row and column of the entry
+  const char* free_mask = nullptr;                     // during numeric(): factorize()'s `free`
   long a_nonzeros = -1;
   std::vector<double> subtree_flops;
   struct Scratch {
@@ -143,9 +148,10 @@ bool CholeskyPreconditioner::factored_in_single_precision() const { return impl_
 long CholeskyPreconditioner::factor_entries() const { return impl_->ready ? static_cast<long>(impl_->values.size()) : 0; }
 double CholeskyPreconditioner::factor_flops() const { return impl_->ready ? impl_->flops : 0.0; }
 
-bool CholeskyPreconditioner::factorize(const Eigen::SparseMatrix<double>& a) {
+bool CholeskyPreconditioner::factorize(const Eigen::SparseMatrix<double>& a, const std::vector<char>* free) {
   Impl& m = *impl_;
   m.ready = false;
+  if (free && static_cast<Eigen::Index>(free->size()) != a.rows()) return false;
   Eigen::SparseMatrix<double>& matrix = const_cast<Eigen::SparseMatrix<double>&>(a);  // CHOLMOD reads only
   cholmod_sparse view = Eigen::viewAsCholmod(matrix);
   view.stype = -1;  // symmetric: the lower triangle is used
@@ -171,13 +177,24 @@ bool CholeskyPreconditioner::factorize(const Eigen::SparseMatrix<double>& a) {
     m.plan_split();
     m.plan_numeric(a);
   }
+  m.free_mask = free ? free->data() : nullptr;
   m.single = m.single_precision && a.nonZeros() == m.a_nonzeros && m.numeric(a);
+  m.free_mask = nullptr;
   if (m.single) {
     m.ready = true;
     return true;
   }
   // CHOLMOD in double precision: without the single-precision option, or where it met a pivot
   // that is not positive (a matrix too ill-conditioned for single precision).
+  Eigen::SparseMatrix<double> dirichlet;
+  if (free) {
+    dirichlet = a;
+    for (Eigen::Index col = 0; col < dirichlet.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(dirichlet, col); it; ++it)
+        if (!(*free)[col] || !(*free)[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+    view = Eigen::viewAsCholmod(dirichlet);
+    view.stype = -1;
+  }
   if (!cholmod_factorize(&view, m.factor, &m.common) || m.common.status != CHOLMOD_OK || !m.factor->is_super ||
       !m.factor->is_ll || m.factor->minor < m.factor->n)
     return false;
@@ -237,7 +254,7 @@ void CholeskyPreconditioner::Impl::plan_numeric(const Eigen::SparseMatrix<double
   }
   // Where each entry of A's lower triangle (in the permuted order) goes in the factor's blocks.
   gather_start.assign(1, 0);
-  gather_src.clear(), gather_dst.clear();
+  gather_src.clear(), gather_dst.clear(), gather_row.clear(), gather_col.clear();
   std::vector<int> local(n, -1);
   for (int s = 0; s < nsuper; ++s) {
     const int height = row_start[s + 1] - row_start[s];
@@ -248,6 +265,8 @@ void CholeskyPreconditioner::Impl::plan_numeric(const Eigen::SparseMatrix<double
         const int i = pinv[a.innerIndexPtr()[e]];
         if (i < k) continue;
         gather_src.push_back(e);
+        gather_row.push_back(a.innerIndexPtr()[e]);
+        gather_col.push_back(j);
         gather_dst.push_back(value_start[s] + static_cast<long>(k - super[s]) * height + local[i]);
       }
     }
@@ -257,42 +276,125 @@ void CholeskyPreconditioner::Impl::plan_numeric(const Eigen::SparseMatrix<double
   values.assign(static_cast<size_t>(value_start.back()), 0.0f);
 }
 
+namespace {
+
+const char kLower = 'L', kNo = 'N', kTranspose = 'T', kRight = 'R';
+const float kOne = 1.0f, kZero = 0.0f, kMinusOne = -1.0f;
+
+// Subtracts the update of descendant rows x (m2 rows from the first of s's columns, dcols columns,
+// leading dimension ld) restricted to x's rows ja … jb−1 as columns: block[local[row i], row j − col0]
+// −= Σ_c x(i, c) x(j, c) for ja ≤ j < jb, j ≤ i < m2. `r` are the rows' global indices.
+void subtract_update(const float* x, int ld, int dcols, int m2, int ja, int jb, const int* r, const int* local, int col0,
+                     float* block, int height, std::vector<float>& buffer) {
+  const int width = jb - ja, tall = m2 - ja;
+  if (width <= 0) return;
+  if (buffer.size() < static_cast<size_t>(width) * tall) buffer.resize(static_cast<size_t>(width) * tall);
+  float* w = buffer.data();
+  const float* xa = x + ja;
+  ssyrk_(&kLower, &kNo, &width, &dcols, &kOne, xa, &ld, &kZero, w, &tall, 1, 1);
+  const int below = tall - width;
+  if (below > 0) sgemm_(&kNo, &kTranspose, &below, &width, &dcols, &kOne, xa + width, &ld, xa, &ld, &kZero, w + width, &tall, 1, 1);
+  for (int j = 0; j < width; ++j) {
+    float* target = block + static_cast<long>(r[ja + j] - col0) * height;
+    const float* source = w + static_cast<long>(j) * tall;
+    for (int i = j; i < tall; ++i) target[local[r[ja + i]]] -= source[i];
+  }
+}
+
+// Columns per task in the parallel path of a large supernode (also the block size of its
+// factorisation). Fixed, so the arithmetic does not depend on the number of threads.
+constexpr int kChunk = 64;
+
+}  // namespace
+
 bool CholeskyPreconditioner::Impl::numeric_supernode(int s, const double* a_values) {
   Scratch& tmp = scratch.local();
   if (tmp.local.size() < perm.size()) tmp.local.assign(perm.size(), 0);
   const int col0 = super[s], cols = super[s + 1] - col0, height = row_start[s + 1] - row_start[s];
   float* block = values.data() + value_start[s];
   std::fill(block, block + static_cast<long>(height) * cols, 0.0f);
-  for (int g = gather_start[s]; g < gather_start[s + 1]; ++g) values[gather_dst[g]] = static_cast<float>(a_values[gather_src[g]]);
-  for (int p = row_start[s]; p < row_start[s + 1]; ++p) tmp.local[rows[p]] = p - row_start[s];
-  const char lower = 'L', no = 'N', transpose = 'T', right = 'R';
-  const float one = 1.0f, zero = 0.0f;
-  for (int u = update_start[s]; u < update_start[s + 1]; ++u) {
-    const int d = update_from[u];
-    const int dcols = super[d + 1] - super[d], dheight = row_start[d + 1] - row_start[d];
-    const int first = update_first[u];
-    const int m1 = update_end[u] - first;        // d's rows among s's columns
-    const int m2 = row_start[d + 1] - first;     // d's rows from s's first column on
-    const float* x = values.data() + value_start[d] + (first - row_start[d]);
-    if (tmp.update.size() < static_cast<size_t>(m1) * m2) tmp.update.resize(static_cast<size_t>(m1) * m2);
-    float* w = tmp.update.data();
-    // W = X Xᵀ restricted to rows 0…m2 × columns 0…m1 (the top square's lower triangle only).
-    ssyrk_(&lower, &no, &m1, &dcols, &one, x, &dheight, &zero, w, &m2, 1, 1);
-    const int m3 = m2 - m1;
-    if (m3 > 0) sgemm_(&no, &transpose, &m3, &m1, &dcols, &one, x + m1, &dheight, x, &dheight, &zero, w + m1, &m2, 1, 1);
-    const int* r = rows.data() + first;
-    for (int j = 0; j < m1; ++j) {
-      float* target = block + static_cast<long>(r[j] - col0) * height;
-      const float* source = w + static_cast<long>(j) * m2;
-      for (int i = j; i < m2; ++i) target[tmp.local[r[i]]] -= source[i];
-    }
+  for (int g = gather_start[s]; g < gather_start[s + 1]; ++g) {
+    const int i = gather_row[g], j = gather_col[g];
+    const bool identity = free_mask && !(free_mask[i] && free_mask[j]);
+    values[gather_dst[g]] = identity ? (i == j ? 1.0f : 0.0f) : static_cast<float>(a_values[gather_src[g]]);
   }
-  int info = 0;
-  spotrf_(&lower, &cols, block, &height, &info, 1);
-  if (info != 0) return false;
+  for (int p = row_start[s]; p < row_start[s + 1]; ++p) tmp.local[rows[p]] = p - row_start[s];
+  const int* local = tmp.local.data();
   const int below = height - cols;
-  if (below > 0) strsm_(&right, &lower, &transpose, &no, &below, &cols, &one, block, &height, block + cols, &height, 1, 1, 1, 1);
-  return true;
+  if (cols < 2 * kChunk) {
+    for (int u = update_start[s]; u < update_start[s + 1]; ++u) {
+      const int d = update_from[u], first = update_first[u];
+      subtract_update(values.data() + value_start[d] + (first - row_start[d]), row_start[d + 1] - row_start[d],
+                      super[d + 1] - super[d], row_start[d + 1] - first, 0, update_end[u] - first, rows.data() + first, local,
+                      col0, block, height, tmp.update);
+    }
+    int info = 0;
+    spotrf_(&kLower, &cols, block, &height, &info, 1);
+    if (info != 0) return false;
+    if (below > 0) strsm_(&kRight, &kLower, &kTranspose, &kNo, &below, &cols, &kOne, block, &height, block + cols, &height, 1, 1, 1, 1);
+    return true;
+  }
+  // A large supernode (the top separators: on the 2542-vertex sleeve a chain of five with 192 …
+  // 993 columns holds most of the flops and has nothing to run beside it): both cores share it.
+  // The updates go by chunks of its columns (each chunk takes every descendant's rows that fall
+  // into it), then a blocked right-looking factorisation with the rows under the diagonal block
+  // solved along. Isolated, so a waiting thread does not pick up another supernode's task (which
+  // would refill its row map in use here).
+  const int chunks = (cols + kChunk - 1) / kChunk;
+  bool ok = true;
+  tbb::this_task_arena::isolate([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, chunks, 1), [&](const tbb::blocked_range<int>& range) {
+      std::vector<float>& buffer = scratch.local().update;
+      for (int c = range.begin(); c != range.end(); ++c) {
+        const int lo = col0 + c * kChunk, hi = std::min(col0 + cols, lo + kChunk);
+        for (int u = update_start[s]; u < update_start[s + 1]; ++u) {
+          const int d = update_from[u], first = update_first[u];
+          const int* r = rows.data() + first;
+          const int m1 = update_end[u] - first;
+          const int ja = static_cast<int>(std::lower_bound(r, r + m1, lo) - r);
+          const int jb = static_cast<int>(std::lower_bound(r + ja, r + m1, hi) - r);
+          subtract_update(values.data() + value_start[d] + (first - row_start[d]), row_start[d + 1] - row_start[d],
+                          super[d + 1] - super[d], row_start[d + 1] - first, ja, jb, r, local, col0, block, height, buffer);
+        }
+      }
+    }, tbb::simple_partitioner());
+    for (int k = 0; k < cols && ok; k += kChunk) {
+      const int kb = std::min(kChunk, cols - k);
+      float* diagonal = block + k + static_cast<long>(k) * height;
+      int info = 0;
+      spotrf_(&kLower, &kb, diagonal, &height, &info, 1);
+      if (info != 0) {
+        ok = false;
+        break;
+      }
+      const int rest = height - k - kb;  // rows under this diagonal block
+      if (rest <= 0) break;
+      const int row_chunks = (rest + 2 * kChunk - 1) / (2 * kChunk);
+      tbb::parallel_for(tbb::blocked_range<int>(0, row_chunks, 1), [&](const tbb::blocked_range<int>& range) {
+        for (int c = range.begin(); c != range.end(); ++c) {
+          const int first_row = k + kb + c * 2 * kChunk, count = std::min(2 * kChunk, height - first_row);
+          strsm_(&kRight, &kLower, &kTranspose, &kNo, &count, &kb, &kOne, diagonal, &height, block + first_row + static_cast<long>(k) * height,
+                 &height, 1, 1, 1, 1);
+        }
+      }, tbb::simple_partitioner());
+      // Trailing columns of the diagonal block: A[j…, j…j+w) −= L[j…, k…k+kb) L[j…j+w, k…k+kb)ᵀ.
+      const int trailing = cols - k - kb;
+      if (trailing <= 0) continue;
+      const int column_chunks = (trailing + kChunk - 1) / kChunk;
+      tbb::parallel_for(tbb::blocked_range<int>(0, column_chunks, 1), [&](const tbb::blocked_range<int>& range) {
+        for (int c = range.begin(); c != range.end(); ++c) {
+          const int j = k + kb + c * kChunk, w = std::min(kChunk, cols - j), tall = height - j;
+          const float* lj = block + j + static_cast<long>(k) * height;
+          float* target = block + j + static_cast<long>(j) * height;
+          ssyrk_(&kLower, &kNo, &w, &kb, &kMinusOne, lj, &height, &kOne, target, &height, 1, 1);
+          const int under = tall - w;
+          if (under > 0)
+            sgemm_(&kNo, &kTranspose, &under, &w, &kb, &kMinusOne, lj + w, &height, lj, &height, &kOne, target + w, &height, 1, 1);
+        }
+      }, tbb::simple_partitioner());
+    }
+  });
+  return ok;
 }
 
 bool CholeskyPreconditioner::Impl::numeric_subtree(int s, const double* a_values) {

@@ -18,6 +18,7 @@
 #include <Eigen/SparseCore>
 
 #include <memory>
+#include <vector>
 
 namespace clothsim {
 
@@ -35,7 +36,9 @@ class CholeskyPreconditioner {
   // Factorises A (symmetric, full storage; the lower triangle is read). The symbolic analysis
   // (AMD ordering, supernodes) is done on the first call; later matrices must have the same
   // pattern. Returns false, and keeps no factor, when A is not positive definite.
-  bool factorize(const Eigen::SparseMatrix<double>& a);
+  // With `free` (one flag per row), the factor is of A's Dirichlet form: the rows and columns of the
+  // components with free[i] == 0 replaced by those of the identity (A itself is not copied).
+  bool factorize(const Eigen::SparseMatrix<double>& a, const std::vector<char>* free = nullptr);
   bool ready() const;
   // Whether the current factor was computed in single precision (false: by CHOLMOD, in double).
   bool factored_in_single_precision() const;
