@@ -54,7 +54,7 @@ TEST(CholeskyPreconditioned, MatchesTheDirectSolveAndReusesTheFactor) {
   const Eigen::MatrixX3d moved = direct.state().x - p.mesh.vertices;
   const double size = moved.cwiseAbs().maxCoeff();
   ASSERT_GT(size, 1e-2);  // the sleeve has swung with its rim: the elements turned
-  EXPECT_LT((pcg.state().x - direct.state().x).cwiseAbs().maxCoeff(), 1e-9 * size);  // measured 7.5e-14
+  EXPECT_LT((pcg.state().x - direct.state().x).cwiseAbs().maxCoeff(), 1e-9 * size);  // measured 2.7e-13
   // The factor is reused over several steps and refreshed when the matrix has drifted (on this
   // small mesh a factorisation costs only a few iterations, so the rule refreshes it often:
   // measured 20 factorisations in 40 steps, 282 iterations).
