@@ -291,18 +291,14 @@ StepStats Simulator::step() {
     t0 = std::chrono::steady_clock::now();
     // Dirichlet form of the system for CHOLMOD: prescribed columns moved to the right-hand side,
     // unit diagonal in their rows and columns.
-    auto dirichlet = [&](Eigen::SparseMatrix<double>& matrix, Eigen::VectorXd* rhs) {
-      if (rhs) {
-        Eigen::VectorXd fixed_values = Eigen::VectorXd::Zero(3 * m.n);
-        for (Eigen::Index i = 0; i < 3 * m.n; ++i)
-          if (!m.solve_free[i]) fixed_values(i) = v_next(i);
-        *rhs -= matrix * fixed_values;
-        for (Eigen::Index i = 0; i < 3 * m.n; ++i)
-          if (!m.solve_free[i]) (*rhs)(i) = fixed_values(i);
-      }
-      for (Eigen::Index col = 0; col < matrix.outerSize(); ++col)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(matrix, col); it; ++it)
-          if (!m.solve_free[col] || !m.solve_free[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+    auto dirichlet = [&](Eigen::SparseMatrix<double>& matrix, Eigen::VectorXd& rhs) {
+      Eigen::VectorXd fixed_values = Eigen::VectorXd::Zero(3 * m.n);
+      for (Eigen::Index i = 0; i < 3 * m.n; ++i)
+        if (!m.solve_free[i]) fixed_values(i) = v_next(i);
+      rhs -= matrix * fixed_values;
+      for (Eigen::Index i = 0; i < 3 * m.n; ++i)
+        if (!m.solve_free[i]) rhs(i) = fixed_values(i);
+      set_dirichlet_identity(matrix, m.solve_free);
     };
     auto refactor = [&] {
       const auto f0 = std::chrono::steady_clock::now();
@@ -362,7 +358,7 @@ StepStats Simulator::step() {
         throw SimulationError(step_number, t_next, s.str(), SimulationError::Kind::solver);
       }
     } else {
-      dirichlet(a, &b);
+      dirichlet(a, b);
       const auto f0 = std::chrono::steady_clock::now();
       const bool factored = m.direct.refactorize(a);
       ++stats.factorizations;

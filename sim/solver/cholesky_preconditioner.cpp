@@ -1,5 +1,6 @@
 #include "sim/solver/cholesky_preconditioner.hpp"
 
+#include "sim/solver/direct_solver.hpp"
 #include "sim/solver/supernodal_kernels.hpp"
 
 #include <Eigen/CholmodSupport>
@@ -15,7 +16,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdlib>
 #include <cstddef>
 #include <vector>
 
@@ -189,9 +189,7 @@ bool CholeskyPreconditioner::factorize(const Eigen::SparseMatrix<double>& a, con
   Eigen::SparseMatrix<double> dirichlet;
   if (free) {
     dirichlet = a;
-    for (Eigen::Index col = 0; col < dirichlet.outerSize(); ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(dirichlet, col); it; ++it)
-        if (!(*free)[col] || !(*free)[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+    set_dirichlet_identity(dirichlet, *free);
     view = Eigen::viewAsCholmod(dirichlet);
     view.stype = -1;
   }

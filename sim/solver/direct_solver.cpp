@@ -4,6 +4,12 @@
 
 namespace clothsim {
 
+void set_dirichlet_identity(Eigen::SparseMatrix<double>& a, const std::vector<char>& free) {
+  for (Eigen::Index col = 0; col < a.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it)
+      if (!free[col] || !free[it.row()]) it.valueRef() = it.row() == col ? 1.0 : 0.0;
+}
+
 struct DirectSolver::Impl {
   // LLᵀ (a matrix that is not positive definite fails the factorisation), AMD ordering:
   // measured fastest on shell stiffness matrices with OpenBLAS (docs/performance.md).

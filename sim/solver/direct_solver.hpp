@@ -6,8 +6,13 @@
 #include <Eigen/SparseCore>
 
 #include <memory>
+#include <vector>
 
 namespace clothsim {
+
+// The Dirichlet form of a symmetric matrix's constrained components, in place: the rows and
+// columns of the entries with free[i] == 0 become those of the identity (pattern kept).
+void set_dirichlet_identity(Eigen::SparseMatrix<double>& a, const std::vector<char>& free);
 
 class DirectSolver {
  public:
