@@ -1,5 +1,7 @@
 #include "sim/dynamics/corotation.hpp"
 
+#include "sim/dynamics/assembly_kernels.hpp"
+
 #include "sim/shell/element.hpp"
 #include "sim/subdivision/box_spline.hpp"
 #include "sim/subdivision/patch.hpp"
@@ -18,6 +20,12 @@
 
 namespace clothsim {
 
+bool assembly_avx2::supported() {
+  __builtin_cpu_init();
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return has;
+}
+
 namespace {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -27,18 +35,42 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 // A patch vector (3·#patch) on the stack.
 using PatchVector = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxPatchDofs, 1>;
 
-// acc += R K Rᵀ for two 3 × 3 blocks at once (lane = block): r[i + 3 j] = R(i, j) and
-// acc[i + 3 j] = entry (i, j) in each lane; entry (i, j) of the two K at k[2 (i + 3 j) + lane].
-// t = K Rᵀ one column at a time keeps the live registers few.
-inline void add_rotated_pair(const Eigen::Array2d* r, const double* k, Eigen::Array2d* acc) {
-  auto kk = [k](int c) { return Eigen::Map<const Eigen::Array2d, Eigen::Aligned16>(k + 2 * c); };
-  for (int j = 0; j < 3; ++j) {
-    const Eigen::Array2d t0 = kk(0) * r[j] + kk(3) * r[j + 3] + kk(6) * r[j + 6];
-    const Eigen::Array2d t1 = kk(1) * r[j] + kk(4) * r[j + 3] + kk(7) * r[j + 6];
-    const Eigen::Array2d t2 = kk(2) * r[j] + kk(5) * r[j + 3] + kk(8) * r[j + 6];
-    for (int i = 0; i < 3; ++i) acc[i + 3 * j] += r[i] * t0 + r[i + 3] * t1 + r[i + 6] * t2;
+using assembly_avx2::kLanes;
+using Lanes = Eigen::Array<double, kLanes, 1>;
+
+}  // namespace
+
+void assembly_avx2::sum_block_portable(int groups, const int* element, const double* rotations, const double* stiffness, const double* rows,
+                        const double* tension, const int* point_offset, int points, double* out) {
+  Lanes acc[9], r[9];
+  for (Lanes& a : acc) a.setZero();
+  for (int g = 0; g < groups; ++g, element += kLanes, stiffness += 9 * kLanes) {
+    for (int c = 0; c < 9; ++c)
+      for (int l = 0; l < kLanes; ++l) r[c](l) = rotations[9 * static_cast<long>(element[l]) + c];
+    auto k = [stiffness](int c) { return Eigen::Map<const Lanes>(stiffness + kLanes * c); };
+    for (int j = 0; j < 3; ++j) {
+      const Lanes t0 = k(0) * r[j] + k(3) * r[j + 3] + k(6) * r[j + 6];
+      const Lanes t1 = k(1) * r[j] + k(4) * r[j + 3] + k(7) * r[j + 6];
+      const Lanes t2 = k(2) * r[j] + k(5) * r[j + 3] + k(8) * r[j + 6];
+      for (int i = 0; i < 3; ++i) acc[i + 3 * j] += r[i] * t0 + r[i + 3] * t1 + r[i + 6] * t2;
+    }
+    if (!tension) continue;
+    const double* products = rows + static_cast<long>(g) * 3 * kLanes * points;
+    for (int q = 0; q < points; ++q, products += 3 * kLanes) {
+      Lanes n11, n12, n22;
+      for (int l = 0; l < kLanes; ++l) {
+        const double* t = tension + 3 * static_cast<long>(point_offset[element[l]] + q);
+        n11(l) = t[0], n12(l) = t[1], n22(l) = t[2];
+      }
+      const Lanes geometric = Eigen::Map<const Lanes>(products) * n11 + Eigen::Map<const Lanes>(products + kLanes) * n12 +
+                              Eigen::Map<const Lanes>(products + 2 * kLanes) * n22;
+      for (int i = 0; i < 3; ++i) acc[4 * i] += geometric;
+    }
   }
+  for (int c = 0; c < 9; ++c) out[c] = (acc[c](0) + acc[c](1)) + (acc[c](2) + acc[c](3));
 }
+
+namespace {
 
 // Positive part of a symmetric 2 × 2 membrane force n = (n¹¹, n²², n¹²): zero without tension,
 // n itself when both eigenvalues are ≥ 0, else high·v vᵀ = high (N − low I)/(high − low) with
@@ -155,7 +187,13 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
   rest_patch_.resize(patch_offset_[count]);
   x_patch_.resize(patch_offset_[count]);
   local_force_.resize(patch_offset_[count]);
-  tangent_rows_.resize(count);
+  tangent_rows_.resize(2 * static_cast<size_t>(patch_offset_[count] / 3));
+  patch_vertex_.resize(static_cast<size_t>(patch_offset_[count] / 3));
+  identity_.resize(count);
+  for (size_t e = 0; e < count; ++e) {
+    identity_[e] = elements[e].identity;
+    for (size_t p = 0; p < elements[e].patch.size(); ++p) patch_vertex_[static_cast<size_t>(patch_offset_[e] / 3) + p] = elements[e].patch[p];
+  }
   rest_a1_.resize(count);
   rest_a2_.resize(count);
   rotation_.assign(count, Eigen::Matrix3d::Identity());
@@ -190,11 +228,12 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
         rest_patch_.segment<3>(patch_offset_[e] + 3 * p) = rest.row(el.patch[p]).transpose();
       // Tangent rows at the barycentre (the paper's choice for the element rotation).
       const PatchEvaluation centre = evaluate_patch(model.extended().topology, el.triangle, 1.0 / 3, 1.0 / 3);
-      tangent_rows_[e] = centre.basis.middleRows(1, 2);  // kDv, kDw
+      Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic>>(tangent_rows_.data() + 2 * (patch_offset_[e] / 3), 2, np) =
+          centre.basis.middleRows(1, 2);  // kDv, kDw
       Eigen::MatrixX3d x(np, 3);
       for (Eigen::Index p = 0; p < np; ++p) x.row(p) = rest.row(el.patch[p]);
-      rest_a1_[e] = (tangent_rows_[e].row(0) * x).transpose();
-      rest_a2_[e] = (tangent_rows_[e].row(1) * x).transpose();
+      rest_a1_[e] = (centre.basis.row(1) * x).transpose();
+      rest_a2_[e] = (centre.basis.row(2) * x).transpose();
       for (size_t q = 0; q < el.basis.size(); ++q) {
         const size_t point = static_cast<size_t>(point_offset_[e]) + q;
         const SurfacePoint s = surface_point(el.basis[q], x);
@@ -256,6 +295,7 @@ void CorotationalElements::build_assembly(std::vector<std::vector<double>>& pack
   // is gathered like an identity one, with Tᵀ K_e T and the basis rows N,α W.
   const size_t count = elements.size(), blocks = block_upper_.size();
   std::vector<int> contributions(blocks, 0);
+  constexpr size_t lanes = kLanes;
   auto for_each_block = [&](auto&& add) {
     for (size_t e = 0; e < count; ++e) {
       if (packed[e].empty()) continue;
@@ -270,36 +310,37 @@ void CorotationalElements::build_assembly(std::vector<std::vector<double>>& pack
     }
   };
   for_each_block([&](size_t, size_t, size_t, bool, int u) { ++contributions[u]; });
-  block_pairs_.assign(blocks + 1, 0);
-  for (size_t u = 0; u < blocks; ++u) block_pairs_[u + 1] = block_pairs_[u] + (contributions[u] + 1) / 2;
-  const size_t pairs = static_cast<size_t>(block_pairs_[blocks]);
-  const size_t rows_per_pair = 6 * static_cast<size_t>(points_per_element_);
-  pair_element_.assign(2 * pairs, -1);
-  pair_stiffness_.assign(18 * pairs, 0.0);
-  pair_rows_.assign(rows_per_pair * pairs, 0.0);
+  block_groups_.assign(blocks + 1, 0);
+  for (size_t u = 0; u < blocks; ++u) block_groups_[u + 1] = block_groups_[u] + (contributions[u] + kLanes - 1) / kLanes;
+  const size_t groups = static_cast<size_t>(block_groups_[blocks]);
+  const size_t rows_per_group = 3 * lanes * static_cast<size_t>(points_per_element_);
+  group_element_.assign(lanes * groups, -1);
+  group_stiffness_.assign(9 * lanes * groups, 0.0);
+  group_rows_.assign(rows_per_group * groups, 0.0);
   std::fill(contributions.begin(), contributions.end(), 0);
   Eigen::Matrix<double, 2, Eigen::Dynamic> rows;
   for_each_block([&](size_t e, size_t a, size_t b, bool transpose, int u) {
     const int k = contributions[u]++;
-    const size_t slot = 2 * static_cast<size_t>(block_pairs_[u] + k / 2) + static_cast<size_t>(k % 2);
-    const size_t pair = slot / 2, lane = slot % 2;
-    pair_element_[slot] = static_cast<int>(e);
+    const size_t slot = lanes * static_cast<size_t>(block_groups_[u] + k / kLanes) + static_cast<size_t>(k % kLanes);
+    const size_t group = slot / lanes, lane = slot % lanes;
+    group_element_[slot] = static_cast<int>(e);
     const Eigen::Index ia = static_cast<Eigen::Index>(a), ib = static_cast<Eigen::Index>(b);
     for (int q = 0; q < points_per_element_; ++q) {
       rows = elements[e].basis[static_cast<size_t>(q)].middleRows(1, 2);  // N,1 and N,2
       if (fold_weights[e].size() > 0) rows = rows * fold_weights[e];
-      double* products = pair_rows_.data() + rows_per_pair * pair + 6 * static_cast<size_t>(q) + lane;
+      double* products = group_rows_.data() + rows_per_group * group + 3 * lanes * static_cast<size_t>(q) + lane;
       products[0] = rows(0, ia) * rows(0, ib);
-      products[2] = rows(0, ia) * rows(1, ib) + rows(1, ia) * rows(0, ib);
-      products[4] = rows(1, ia) * rows(1, ib);
+      products[lanes] = rows(0, ia) * rows(1, ib) + rows(1, ia) * rows(0, ib);
+      products[2 * lanes] = rows(1, ia) * rows(1, ib);
     }
     const Eigen::Map<const Eigen::Matrix3d> block(packed[e].data() + 9 * (b * (b + 1) / 2 + a));
     for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) pair_stiffness_[18 * pair + 2 * (i + 3 * j) + lane] = transpose ? block(j, i) : block(i, j);
+      for (int i = 0; i < 3; ++i) group_stiffness_[lanes * (9 * group + i + 3 * j) + lane] = transpose ? block(j, i) : block(i, j);
     if (a + 1 == elements[e].real.size() && b == a) std::vector<double>().swap(packed[e]);  // its last block
   });
-  for (size_t p = 0; p < pairs; ++p)
-    if (pair_element_[2 * p + 1] < 0) pair_element_[2 * p + 1] = pair_element_[2 * p];  // zero block
+  for (size_t g = 0; g < groups; ++g)
+    for (size_t l = 1; l < lanes; ++l)
+      if (group_element_[lanes * g + l] < 0) group_element_[lanes * g + l] = group_element_[lanes * g];  // zero block
   // The other folded elements (folded_stiffness_ set) add after the gather, colour by colour.
   for (const std::vector<int>& group : model_.color_groups()) {
     std::vector<int> folded;
@@ -327,19 +368,21 @@ void CorotationalElements::evaluate(const Eigen::VectorXd& u) {
   const size_t count = model_.elements().size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 32), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t e = range.begin(); e != range.end(); ++e) {
-      const ShellElement& el = model_.elements()[e];
-      const Eigen::Index offset = patch_offset_[e], np = static_cast<Eigen::Index>(el.patch.size());
+      // Flat per-patch-vertex arrays in element order (not the ShellElement objects): a stream.
+      const Eigen::Index offset = patch_offset_[e], np = (patch_offset_[e + 1] - offset) / 3;
       auto x = x_patch_.segment(offset, 3 * np);
-      if (el.identity)
+      const int* vertex = patch_vertex_.data() + offset / 3;
+      if (identity_[e])
         for (Eigen::Index p = 0; p < np; ++p)
-          x.segment<3>(3 * p) = rest_patch_.segment<3>(offset + 3 * p) + u.segment<3>(3 * el.patch[p]);
+          x.segment<3>(3 * p) = rest_patch_.segment<3>(offset + 3 * p) + u.segment<3>(3 * static_cast<Eigen::Index>(vertex[p]));
       else
         x = rest_patch_.segment(offset, 3 * np) + model_.patch_vector(static_cast<int>(e), u);
       if (!corotational_) continue;
+      const double* rows = tangent_rows_.data() + 2 * (offset / 3);
       Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
       for (Eigen::Index p = 0; p < np; ++p) {
-        a1 += tangent_rows_[e](0, p) * x.segment<3>(3 * p);
-        a2 += tangent_rows_[e](1, p) * x.segment<3>(3 * p);
+        a1 += rows[2 * p] * x.segment<3>(3 * p);
+        a2 += rows[2 * p + 1] * x.segment<3>(3 * p);
       }
       extract_rotation(rest_a1_[e], rest_a2_[e], a1, a2, rotation_[e]);  // keeps the last R if degenerate
     }
@@ -387,34 +430,23 @@ void CorotationalElements::assemble_stiffness(Eigen::SparseMatrix<double>& k) co
   if (k.rows() != pattern.rows() || k.cols() != pattern.cols() || !k.isCompressed() || k.nonZeros() != pattern.nonZeros())
     k = pattern;
   double* values = k.valuePtr();
+  const auto sum = assembly_avx2::supported() ? assembly_avx2::sum_block : assembly_avx2::sum_block_portable;
+  const double* rotations = rotation_.empty() ? nullptr : rotation_.front().data();  // Matrix3d: 9 contiguous values each
+  const double* tension = tension_stiffening_ ? tension_.data() : nullptr;
   // Every value is written here (the gather covers the whole pattern).
   tbb::parallel_for(tbb::blocked_range<size_t>(0, block_upper_.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t u = range.begin(); u != range.end(); ++u) {
-      Eigen::Array2d acc[9], r[9];
-      for (Eigen::Array2d& entry : acc) entry.setZero();
-      for (int p = block_pairs_[u]; p < block_pairs_[u + 1]; ++p) {
-        const double* r0 = rotation_[pair_element_[2 * p]].data();
-        const double* r1 = rotation_[pair_element_[2 * p + 1]].data();
-        for (int c = 0; c < 9; ++c) r[c] = Eigen::Array2d(r0[c], r1[c]);
-        add_rotated_pair(r, pair_stiffness_.data() + 18 * static_cast<size_t>(p), acc);
-        if (!tension_stiffening_) continue;
-        // G_ab = Σ_q (products · w n₊) on the diagonal.
-        const double* products = pair_rows_.data() + 6 * static_cast<size_t>(points_per_element_) * static_cast<size_t>(p);
-        for (int q = 0; q < points_per_element_; ++q, products += 6) {
-          const double* t0 = tension_.data() + 3 * static_cast<size_t>(point_offset_[pair_element_[2 * p]] + q);
-          const double* t1 = tension_.data() + 3 * static_cast<size_t>(point_offset_[pair_element_[2 * p + 1]] + q);
-          const Eigen::Array2d g = Eigen::Map<const Eigen::Array2d, Eigen::Aligned16>(products) * Eigen::Array2d(t0[0], t1[0]) +
-                                   Eigen::Map<const Eigen::Array2d, Eigen::Aligned16>(products + 2) * Eigen::Array2d(t0[1], t1[1]) +
-                                   Eigen::Map<const Eigen::Array2d, Eigen::Aligned16>(products + 4) * Eigen::Array2d(t0[2], t1[2]);
-          for (int i = 0; i < 3; ++i) acc[4 * i] += g;
-        }
-      }
+      double acc[9];
+      const size_t first = static_cast<size_t>(block_groups_[u]);
+      sum(block_groups_[u + 1] - block_groups_[u], group_element_.data() + kLanes * first, rotations,
+          group_stiffness_.data() + 9 * kLanes * first, group_rows_.data() + 3 * kLanes * static_cast<size_t>(points_per_element_) * first,
+          tension, point_offset_.data(), points_per_element_, acc);
       double* upper = values + block_upper_[u];
       double* lower = values + block_lower_[u];
       const int su = block_stride_upper_[u], sl = block_stride_lower_[u];
       for (int j = 0; j < 3; ++j)
         for (int i = 0; i < 3; ++i) {
-          const double value = acc[i + 3 * j](0) + acc[i + 3 * j](1);
+          const double value = acc[i + 3 * j];
           upper[j * su + i] = value;
           if (lower != upper) lower[i * sl + j] = value;  // a diagonal block is written once, as summed
         }
@@ -468,10 +500,11 @@ Eigen::MatrixX2d CorotationalElements::membrane_principal_strains(const Eigen::V
     for (size_t e = range.begin(); e != range.end(); ++e) {
       const Eigen::VectorXd x =
           rest_patch_.segment(patch_offset_[e], patch_offset_[e + 1] - patch_offset_[e]) + model_.patch_vector(static_cast<int>(e), u);
+      const double* rows = tangent_rows_.data() + 2 * (patch_offset_[e] / 3);
       Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
       for (Eigen::Index p = 0; p < x.size() / 3; ++p) {
-        a1 += tangent_rows_[e](0, p) * x.segment<3>(3 * p);
-        a2 += tangent_rows_[e](1, p) * x.segment<3>(3 * p);
+        a1 += rows[2 * p] * x.segment<3>(3 * p);
+        a2 += rows[2 * p + 1] * x.segment<3>(3 * p);
       }
       Eigen::Matrix2d g, rest;
       g << a1.dot(a1), a1.dot(a2), a1.dot(a2), a2.dot(a2);

@@ -82,7 +82,11 @@ class CorotationalElements {
   // current x_e and the local force, so that evaluate() allocates nothing.
   std::vector<Eigen::Index> patch_offset_;
   Eigen::VectorXd rest_patch_, x_patch_, local_force_;
-  std::vector<Eigen::Matrix<double, 2, Eigen::Dynamic>> tangent_rows_;  // ∂N/∂v, ∂N/∂w at the barycentre
+  // Per patch vertex (element e's from patch_offset_[e] / 3): ∂N/∂v, ∂N/∂w at the barycentre
+  // (2 each) and the extended-mesh vertex; per element, whether its patch is the identity map.
+  std::vector<double> tangent_rows_;
+  std::vector<int> patch_vertex_;
+  std::vector<char> identity_;
   std::vector<Eigen::Vector3d> rest_a1_, rest_a2_;
   std::vector<Eigen::Matrix3d> rotation_;
   // Per quadrature point (element e's from point_offset_[e]): membrane and bending strain
@@ -103,17 +107,17 @@ class CorotationalElements {
   // pattern sums its element blocks R K_ab Rᵀ (K_ab stored already oriented as (I, J)) in
   // registers and is written once, with its transpose at (J, I): no zeroing and no scattered
   // read-modify-write per element block, and each sum has a fixed order (deterministic in
-  // parallel). The contributions come in pairs (SSE lanes; an odd one out is paired with a zero
-  // block): pair p holds the two elements, their K blocks interleaved (18 values, entry (i, j)
-  // at 2 (i + 3 j) + lane) and, per quadrature point, the basis-row products that turn tension_
-  // into G_ab (N_a,1 N_b,1, N_a,1 N_b,2 + N_a,2 N_b,1, N_a,2 N_b,2, interleaved likewise).
+  // parallel). The contributions come in groups of four (vector lanes, sim/dynamics/
+  // assembly_kernels.hpp, where the layout is described; a short group is padded with zero blocks):
+  // the elements, their K blocks interleaved and, per quadrature point, the basis-row products
+  // that turn tension_ into G_ab.
   std::vector<int> block_upper_, block_lower_;  // value offsets of (I, J) and (J, I) per block
   std::vector<int> block_stride_upper_, block_stride_lower_;  // column strides of J and I
-  std::vector<int> block_pairs_;  // contribution pairs of block u: [block_pairs_[u], block_pairs_[u + 1])
-  std::vector<int> pair_element_;      // 2 per pair
-  std::vector<double> pair_stiffness_;  // 18 per pair
-  std::vector<double> pair_rows_;       // 6 per pair and quadrature point
-  int points_per_element_ = 0;          // the same rule for every element
+  std::vector<int> block_groups_;  // contribution groups of block u: [block_groups_[u], block_groups_[u + 1])
+  std::vector<int> group_element_;      // 4 per group
+  std::vector<double> group_stiffness_;  // 36 per group
+  std::vector<double> group_rows_;       // 12 per group and quadrature point
+  int points_per_element_ = 0;           // the same rule for every element
   // The other folded elements (clamped borders, partly fixed vertices): K_e (3·#patch square)
   // and their colour groups; folded and added after the gather.
   std::vector<Eigen::MatrixXd> folded_stiffness_;  // by element, empty for identity elements

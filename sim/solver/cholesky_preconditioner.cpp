@@ -67,7 +67,7 @@ class SingleThreadedBlas {
 
 bool supernodal_avx2::supported() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
 }
 
 struct CholeskyPreconditioner::Impl {

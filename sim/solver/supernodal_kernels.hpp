@@ -9,7 +9,7 @@
 
 namespace clothsim::supernodal_avx2 {
 
-// Whether this processor can run the kernels below (defined in cholesky_preconditioner.cpp, which
+// Whether this processor can run the kernels below (AVX2, FMA, F16C) (defined in cholesky_preconditioner.cpp, which
 // is compiled for the baseline instruction set).
 bool supported();
 // Forward step: ys ← D⁻¹ ys (D the diagonal block), below ← (rows under D) · ys.

@@ -94,7 +94,7 @@ const Manifest& manifest() {
 std::string read_bytes(const fs::path& path) { return clothsim::testing::read_file_bytes(path); }
 using clothsim::testing::shell_quote;
 
-// A test name from a golden's file name: "sleeve_twist_t0.3.png" → "sleeve_twist_t0_3".
+// A test name from a golden's file name: "sleeve_compress_t0.1.png" → "sleeve_compress_t0_1".
 std::string test_name(const Golden& g) {
   std::string name = fs::path(g.file).stem().string();
   for (char& c : name)
