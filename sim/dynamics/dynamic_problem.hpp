@@ -43,6 +43,9 @@ struct SolverSettings {
   PreconditionerType preconditioner = PreconditionerType::block_jacobi;  // pcg
   int refresh_iterations = 50;  // cholesky preconditioner: refactor after a solve that needed more
   bool tension_stiffening = true;  // membrane geometric stiffness in the matrix (corotation.hpp)
+  // pcg's start: the last velocity extrapolated by its last change, v + (v − v_prev)
+  // (constant acceleration), or the last velocity itself.
+  bool extrapolated_start = true;
 };
 
 // Rigid initial velocity field v = velocity + angular_velocity × (X − center).

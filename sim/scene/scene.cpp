@@ -602,7 +602,7 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   if (j == nullptr) return s;
   r.check_object(*j, "solver",
                  {"type", "tolerance", "max_iterations", "newton_iterations", "preconditioner", "refresh_iterations",
-                  "tension_stiffening"});
+                  "tension_stiffening", "warm_start"});
   if (const Json* v = r.find(*j, "type"))
     s.type = r.choice(*v, "solver.type", {"pcg", "cholmod"}, "solver type") == "cholmod" ? LinearSolverType::cholmod
                                                                                       : LinearSolverType::pcg;
@@ -621,6 +621,9 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   if (const Json* v = r.find(*j, "refresh_iterations"))
     s.refresh_iterations = r.integer_at_least(*v, "solver.refresh_iterations", 1);
   if (const Json* v = r.find(*j, "tension_stiffening")) s.tension_stiffening = r.boolean(*v, "solver.tension_stiffening");
+  if (const Json* v = r.find(*j, "warm_start"))
+    s.extrapolated_start =
+        r.choice(*v, "solver.warm_start", {"extrapolated", "last_velocity"}, "warm start") == "extrapolated";
   return s;
 }
 

@@ -192,6 +192,39 @@ TEST(Dynamics, ScriptedVerticesFollowTheirMotionExactly) {
   EXPECT_NEAR(sim.state().x(v, 1), 0.2 - 0.03, 1e-12);
 }
 
+// The extrapolated start of the conjugate gradients (v + (v − v_prev)) against the last velocity:
+// the same motion within the solver's tolerance, in fewer iterations (a sleeve compressed at a
+// steady rate, the regime it is meant for; measured 1057 instead of 1214 iterations, positions
+// equal to 2e-16 m).
+TEST(Dynamics, ExtrapolatedStartSavesIterationsNotAccuracy) {
+  DynamicProblem p = free_sleeve(5000);
+  p.solver.tolerance = 1e-10;
+  BoundaryCondition bottom, top;
+  for (int v = 0; v < p.mesh.num_vertices(); ++v) {
+    if (p.mesh.vertices(v, 1) < 1e-9) bottom.vertices.push_back(v);
+    if (p.mesh.vertices(v, 1) > 0.2 - 1e-9) top.vertices.push_back(v);
+  }
+  Motion push;
+  push.type = Motion::Type::translate;
+  push.displacement = Eigen::Vector3d(0, -0.01, 0);
+  push.start = 0.0;
+  push.end = 1.0;
+  top.motion = {push};
+  p.boundary = {bottom, top};
+  p.time.end = 0.05;
+  int iterations[2] = {0, 0};
+  Eigen::MatrixX3d x[2];
+  for (int extrapolated = 0; extrapolated < 2; ++extrapolated) {
+    p.solver.extrapolated_start = extrapolated == 1;
+    Simulator sim(p);
+    for (int i = 0; i < sim.num_steps(); ++i) iterations[extrapolated] += sim.step().solver_iterations;
+    x[extrapolated] = sim.state().x;
+  }
+  EXPECT_LT(iterations[1], 0.9 * iterations[0]) << iterations[1] << " vs " << iterations[0];
+  EXPECT_LT((x[1] - x[0]).cwiseAbs().maxCoeff(), 1e-9) << "the motion itself changed";
+  EXPECT_GT((x[1] - p.mesh.vertices).cwiseAbs().maxCoeff(), 1e-4);  // it did move
+}
+
 // The simulator keeps what it needs of the problem: scripted motions still drive the rim after
 // the caller's DynamicProblem is gone (they were once read through pointers into it).
 TEST(Dynamics, ScriptedMotionOutlivesTheCallersProblem) {

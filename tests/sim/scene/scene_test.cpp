@@ -583,7 +583,9 @@ TEST_F(SceneLoader, DynamicSettingErrors) {
                        expected("solver.preconditioner: unknown preconditioner \"jacobi\" (allowed: \"block_jacobi\", \"cholesky\")")));
   EXPECT_TRUE(contains(with(R"("solver": {"precondition": "cholesky"})"),
                        expected("solver.precondition: unknown key (allowed: type, tolerance, max_iterations, "
-                                "newton_iterations, preconditioner, refresh_iterations, tension_stiffening)")));
+                                "newton_iterations, preconditioner, refresh_iterations, tension_stiffening, warm_start)")));
+  EXPECT_TRUE(contains(with(R"("solver": {"warm_start": "zero"})"),
+                       expected("solver.warm_start: unknown warm start \"zero\" (allowed: \"extrapolated\", \"last_velocity\")")));
   EXPECT_EQ(with(R"("corotational": "yes")"), expected("corotational: expected true or false (got \"yes\")"));
   EXPECT_EQ(with(R"("corotational": 1)"), expected("corotational: expected true or false (got 1)"));
   EXPECT_TRUE(contains(with(R"("initial": {"velocity": [0, 0]})"), expected("initial.velocity: expected an array of 3 numbers")));
