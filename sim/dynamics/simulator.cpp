@@ -337,10 +337,11 @@ StepStats Simulator::step() {
         // being solved needs 2 iterations, one a step old 6–9 in the sleeve's slow phases and
         // 15–70 while it snaps into folds. The factorisation's cost in iterations is estimated
         // from its flop count against the flops of one iteration (two triangular solves and a
-        // product with A), scaled by 0.17, the ratio of the two speeds measured when this was
-        // written (factorisation 22 ms ≙ 21 iterations of 1.05 ms on the 2542-vertex sleeve, 2
-        // cores; the optimum is flat: 0.12 / 0.17 / 0.23 give 19.7 / 19.6 / 20.5 ms per step, see
-        // docs/performance.md). Decided on counts, never on timings: runs are repeatable.
+        // product with A), scaled by 0.17, fitted on the 2542-vertex sleeve (2 cores): first with
+        // single-precision solves (factorisation 22 ms ≙ 21 iterations of 1.05 ms), checked again
+        // with half-precision solves (21.5 ms, 0.75 ms per iteration). The optimum is flat:
+        // 0.12 / 0.17 / 0.25 / 0.35 / 0.5 model to 11.4 / 11.3 / 11.7 / 12.0 / 12.5 ms of solve
+        // per step (docs/performance.md). Decided on counts, never on timings: runs are repeatable.
         ++m.solves_since_factor;
         m.iterations_since_factor += r.iterations;
         const double iteration_work = 4.0 * static_cast<double>(m.factor.factor_entries()) + 2.0 * static_cast<double>(a.nonZeros());
