@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <utility>
 
 #include <cmath>
 #include <random>
@@ -30,6 +31,16 @@ DynamicProblem free_sleeve(double stretch = 1e5) {
   p.solver.tolerance = 1e-12;
   p.solver.max_iterations = 5000;
   return p;
+}
+
+// The vertices of the sleeve's two rims (y = 0 and y = 0.2 m), as boundary conditions without motion.
+std::pair<BoundaryCondition, BoundaryCondition> rims(const DynamicProblem& p) {
+  BoundaryCondition bottom, top;
+  for (int v = 0; v < p.mesh.num_vertices(); ++v) {
+    if (p.mesh.vertices(v, 1) < 1e-9) bottom.vertices.push_back(v);
+    if (p.mesh.vertices(v, 1) > 0.2 - 1e-9) top.vertices.push_back(v);
+  }
+  return {bottom, top};
 }
 
 // RMS distance between x and the best rigid image of rest (Kabsch), relative to the size.
@@ -156,11 +167,7 @@ TEST(Dynamics, TotalEnergyNeverRisesWithoutExternalWork) {
 
 TEST(Dynamics, ScriptedVerticesFollowTheirMotionExactly) {
   DynamicProblem p = free_sleeve(5000);
-  BoundaryCondition bottom, top;
-  for (int v = 0; v < p.mesh.num_vertices(); ++v) {
-    if (p.mesh.vertices(v, 1) < 1e-9) bottom.vertices.push_back(v);
-    if (p.mesh.vertices(v, 1) > 0.2 - 1e-9) top.vertices.push_back(v);
-  }
+  auto [bottom, top] = rims(p);
   Motion twist;
   twist.type = Motion::Type::rotate;
   twist.axis = Eigen::Vector3d::UnitY();
@@ -199,11 +206,7 @@ TEST(Dynamics, ScriptedVerticesFollowTheirMotionExactly) {
 TEST(Dynamics, ExtrapolatedStartSavesIterationsNotAccuracy) {
   DynamicProblem p = free_sleeve(5000);
   p.solver.tolerance = 1e-10;
-  BoundaryCondition bottom, top;
-  for (int v = 0; v < p.mesh.num_vertices(); ++v) {
-    if (p.mesh.vertices(v, 1) < 1e-9) bottom.vertices.push_back(v);
-    if (p.mesh.vertices(v, 1) > 0.2 - 1e-9) top.vertices.push_back(v);
-  }
+  auto [bottom, top] = rims(p);
   Motion push;
   push.type = Motion::Type::translate;
   push.displacement = Eigen::Vector3d(0, -0.01, 0);
