@@ -10,6 +10,7 @@
 // frequency atan(ωh)/h (eigenvalues 1/(1 ∓ iωh) of the step map), so the discrete reference
 // period is 2πh / atan(ωh); the step also damps the higher modes the sudden load excites.
 #include "sim/dynamics/simulator.hpp"
+#include "sim/scene/scene.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/shell/material.hpp"
 
@@ -132,6 +133,19 @@ TEST(Vibration, SimplySupportedPlateMatchesTheFundamentalFrequency) {
     previous = std::abs(r.error());
   }
   EXPECT_LT(previous, 0.005);  // 32 × 32 within 0.5 %
+}
+
+// The same plate through the shipped scene file (scene format, probe at the centre).
+TEST(Vibration, ShippedPlateVibrationSceneMatchesTheFundamentalFrequency) {
+  const Scene scene = load_scene(std::string(CLOTHSIM_SOURCE_DIR) + "/scenes/plate_vibration.json", nullptr);
+  const double d = 1e7 * 1e-6 / (12 * (1 - 0.3 * 0.3));
+  const double omega = 2 * std::numbers::pi * std::numbers::pi * std::sqrt(d / (1000 * 0.01));
+  const DynamicProblem& p = scene.dynamic;
+  const Mode m = fitted_mode(run(p, scene.probes.at(0).vertex), p.time.dt, static_cast<std::size_t>(1.0 / p.time.dt));
+  std::printf("plate_vibration.json: omega %.6f rad/s, reference %.6f, error %+.3f %%\n", m.omega, omega,
+              100 * (m.omega / omega - 1));
+  EXPECT_NEAR(m.omega / omega, 1.0, 0.005);
+  EXPECT_LT(std::abs(m.zeta), 5e-4);
 }
 
 // Refined along and across together (the across resolution alone leaves an error that does not
