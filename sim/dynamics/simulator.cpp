@@ -334,8 +334,8 @@ StepStats Simulator::step() {
         // (for a cost that grows steadily this minimises the long-run average), or when it
         // exceeded refresh_iterations. The new factor is of the next step's matrix (taken at the
         // start of that step), not of this one, which is solved already: a factor of the matrix
-        // being solved needs 2 iterations, one a step old 6–9 in the sleeve's slow phases and
-        // 15–70 while it snaps into folds. The factorisation's cost in iterations is estimated
+        // being solved needs 3–4 iterations (half-precision solves), one a step old 5–6 in the
+        // sleeve's slow phases and 9–60 while it snaps into folds. The factorisation's cost in iterations is estimated
         // from its flop count against the flops of one iteration (two triangular solves and a
         // product with A), scaled by 0.17, fitted on the 2542-vertex sleeve (2 cores): first with
         // single-precision solves (factorisation 22 ms ≙ 21 iterations of 1.05 ms), checked again
