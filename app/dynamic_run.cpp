@@ -127,7 +127,7 @@ fs::path create_output_folder(const fs::path& root, const std::string& name) {
 // Warnings about the settings, for the log and summary.json.
 std::vector<std::string> settings_warnings(const Scene& scene, int steps) {
   std::vector<std::string> warnings;
-  const TimeSettings& time = scene.dynamic.time;
+  const TimeSettings& time = scene.problem.time;
   const double last = steps * time.dt;
   if (std::abs(last - time.end) > 1e-9 * time.dt)
     warnings.push_back("time.end = " + format_double(time.end) + " s is not a multiple of time.dt = " +
@@ -182,18 +182,23 @@ class Outputs {
 
   // Probe rows and due frames for the state reached after `step` steps, at time `t` [s].
   void record_state(const Simulator& sim, int step, double t, RunTotals& totals) {
-    const TimeSettings& time = scene_.dynamic.time;
+    const TimeSettings& time = scene_.problem.time;
     const bool frames_wanted = scene_.write_obj_frames || drawer_ != nullptr;
     const bool frame_due = frames_wanted && t >= totals.frames / time.output_fps - 1e-9 * time.dt;
     if (scene_.probes.empty() && !frame_due) return;
-    const Eigen::MatrixX3d limit = sim.limit_positions();
     if (!scene_.probes.empty()) {
-      const Eigen::MatrixX3d& rest = sim.limit_rest();
+      if (probe_points_.num_points() == 0) {  // the probes' surface points, once
+        std::vector<int> nodes;
+        for (const Probe& p : scene_.probes) nodes.push_back(p.vertex);
+        probe_points_ = sim.discretization().node_points(nodes);
+        probe_rest_ = sim.rest_surface_points(probe_points_);
+      }
+      const Eigen::MatrixX3d u = sim.surface_points(probe_points_) - probe_rest_;
       std::string prefix = std::to_string(step);
       prefix.append(1, ',').append(format_double(t)).append(1, ',');
-      for (const Probe& p : scene_.probes) {
-        std::string row = prefix + csv_field(p.name);
-        for (int k = 0; k < 3; ++k) row.append(1, ',').append(format_double(limit(p.vertex, k) - rest(p.vertex, k)));
+      for (std::size_t i = 0; i < scene_.probes.size(); ++i) {
+        std::string row = prefix + csv_field(scene_.probes[i].name);
+        for (int k = 0; k < 3; ++k) row.append(1, ',').append(format_double(u(static_cast<Eigen::Index>(i), k)));
         probes_.line(row);
       }
       probes_.flush();
@@ -207,11 +212,11 @@ class Outputs {
         const std::string comment = "clothsim: limit surface of scene " + scene_.name + ", frame " +
                                     std::to_string(totals.frames) + ", step " + std::to_string(step) +
                                     ", t = " + format_double(t) + " s";
-        write_obj((dir_ / "frames" / file).string(), limit, scene_.dynamic.mesh.triangles, comment);
+        write_obj((dir_ / "frames" / file).string(), sim.node_points(), scene_.problem.mesh.triangles, comment);
       }
       if (drawer_) {
         if (snapshots_.size() == static_cast<std::size_t>(totals.frames)) {
-          snapshots_.push_back(drawer_->snapshot(sim.extended_positions()));
+          snapshots_.push_back(drawer_->snapshot(sim.state().x));
           LimitSurfaceDrawer::extend_bounds(snapshots_.back(), lo_, hi_);
         } else {
           snapshots_.push_back(snapshots_.back());  // a repeated frame
@@ -253,6 +258,8 @@ class Outputs {
   fs::path dir_;
   const LimitSurfaceDrawer* drawer_;
   std::vector<SurfaceSnapshot> snapshots_;
+  SurfaceOperator probe_points_;  // the probes' surface points
+  Eigen::MatrixX3d probe_rest_;   // their rest positions [m]
   render::Vec3f lo_{1e30f, 1e30f, 1e30f}, hi_{-1e30f, -1e30f, -1e30f};
   StreamFile probes_;
   StreamFile stats_;
@@ -309,14 +316,14 @@ void print_summary(const Scene& scene, const Simulator& sim, const RunTotals& to
   std::ostringstream s;
   s << std::setprecision(6);
   s << "scene " << scene.name << " (dynamic)\n";
-  s << "  control vertices " << scene.dynamic.mesh.num_vertices() << ", triangles "
-    << scene.dynamic.mesh.num_triangles() << "\n";
-  s << "  steps " << totals.steps << " of dt = " << scene.dynamic.time.dt << " s, simulated time " << totals.t
+  s << "  control vertices " << scene.problem.mesh.num_vertices() << ", triangles "
+    << scene.problem.mesh.num_triangles() << "\n";
+  s << "  steps " << totals.steps << " of dt = " << scene.problem.time.dt << " s, simulated time " << totals.t
     << " s, wall time " << wall_seconds << " s (rotate " << totals.rotate_ms / 1000.0 << " s, assemble "
     << totals.assemble_ms / 1000.0 << " s, solve " << totals.solve_ms / 1000.0 << " s)\n";
   s << "  max solver iterations per step " << totals.max_solver_iterations << "\n";
   if (!scene.probes.empty()) {
-    const Eigen::MatrixX3d u = sim.limit_positions() - sim.limit_rest();
+    const Eigen::MatrixX3d u = sim.node_points() - sim.node_points_rest();
     for (const Probe& p : scene.probes)
       s << "  probe " << p.name << " (vertex " << p.vertex << "): final displacement [" << u(p.vertex, 0) << ", "
         << u(p.vertex, 1) << ", " << u(p.vertex, 2) << "] m\n";
@@ -336,7 +343,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
   // Everything that can fail before the first step fails here, before any file is written.
   std::unique_ptr<Simulator> sim;
   try {
-    sim = std::make_unique<Simulator>(scene.dynamic);
+    sim = std::make_unique<Simulator>(scene.problem);
   } catch (const std::exception& e) {
     throw std::runtime_error(file + ": cannot set up the dynamic analysis: " + e.what());
   }
@@ -345,7 +352,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
   std::unique_ptr<render::Renderer> renderer;
   if (render_frames) {
     try {
-      drawer = std::make_unique<LimitSurfaceDrawer>(sim->extended_mesh(), scene.render, scene.render.width,
+      drawer = std::make_unique<LimitSurfaceDrawer>(sim->discretization(), scene.render, scene.render.width,
                                                     scene.render.height);
       renderer = std::make_unique<render::Renderer>(scene.render.width, scene.render.height);
     } catch (const std::exception& e) {
@@ -355,8 +362,8 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
   const int steps = sim->num_steps();
   const std::vector<std::string> warnings = settings_warnings(scene, steps);
   for (const std::string& w : warnings) log_line("warning: " + w);
-  log_line("dynamic analysis: " + std::to_string(steps) + " steps of dt = " + format_short(scene.dynamic.time.dt) +
-           " s to t = " + format_short(scene.dynamic.time.end) + " s");
+  log_line("dynamic analysis: " + std::to_string(steps) + " steps of dt = " + format_short(scene.problem.time.dt) +
+           " s to t = " + format_short(scene.problem.time.end) + " s");
 
   fs::path dir;
   try {
@@ -372,7 +379,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
     write_atomically(dir / "summary.json", summary_json(scene, totals, seconds_since(start), warnings, "running", ""));
     outputs = std::make_unique<Outputs>(scene, dir, drawer.get());
     outputs->record_state(*sim, 0, sim->state().t, totals);
-    Progress progress(steps, scene.dynamic.time.output_fps);
+    Progress progress(steps, scene.problem.time.output_fps);
     for (int k = 1; k <= steps; ++k) {
       try {
         const StepStats s = sim->step();
@@ -388,7 +395,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
         throw;
       } catch (const std::exception& e) {
         // Name the step for any other failure (write errors, solver exceptions), as SimulationError does.
-        throw SimulationError(k, k * scene.dynamic.time.dt, e.what());
+        throw SimulationError(k, k * scene.problem.time.dt, e.what());
       }
       progress.update(k, totals.t, totals.frames, seconds_since(start));
     }
@@ -402,7 +409,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
       const int images = outputs->render_frames(*renderer);
       log_line("rendered " + std::to_string(images) + " frame(s) of " + std::to_string(drawer->fine_triangles()) +
                " triangles to " + (dir / "frame_*.png").string());
-      if (video && images > 0) encode_video(dir, scene.name, scene.dynamic.time.output_fps);
+      if (video && images > 0) encode_video(dir, scene.name, scene.problem.time.output_fps);
     } catch (const std::exception& e) {
       if (failure.empty()) failure = std::string("rendering failed: ") + e.what();
       else log_line("warning: rendering failed: " + std::string(e.what()));

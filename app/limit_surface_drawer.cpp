@@ -14,19 +14,20 @@ render::Vec3f to_vec3f(const Eigen::Vector3d& v) {
 }
 }  // namespace
 
-LimitSurfaceDrawer::LimitSurfaceDrawer(const ExtendedMesh& mesh, const RenderSettings& settings, int width, int height)
-    : refinement_(build_limit_refinement(mesh.rest, mesh.triangles, mesh.num_real_triangles, settings.refine)),
-      num_real_(mesh.num_real),
+LimitSurfaceDrawer::LimitSurfaceDrawer(const Discretization& discretization, const RenderSettings& settings, int width,
+                                       int height)
+    : discretization_(discretization),
+      display_(discretization.display(settings.refine)),
       settings_(settings),
       width_(width),
       height_(height) {
-  triangles_.reserve(3 * refinement_.triangles.size());
-  for (const Triangle& t : refinement_.triangles)
+  triangles_.reserve(3 * display_.triangles.size());
+  for (const Triangle& t : display_.triangles)
     for (int v : t) triangles_.push_back(static_cast<unsigned>(v));
   std::vector<std::pair<int, int>> edges;
-  for (int t = 0; t < mesh.num_real_triangles; ++t)
+  for (const Triangle& t : discretization.mesh().triangles)
     for (int k = 0; k < 3; ++k) {
-      const int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      const int a = t[k], b = t[(k + 1) % 3];
       edges.emplace_back(std::min(a, b), std::max(a, b));
     }
   std::sort(edges.begin(), edges.end());
@@ -37,9 +38,9 @@ LimitSurfaceDrawer::LimitSurfaceDrawer(const ExtendedMesh& mesh, const RenderSet
   }
 }
 
-SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::MatrixX3d& extended_positions) const {
+SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::VectorXd& x) const {
   Eigen::MatrixX3d p, n;
-  evaluate_limit(refinement_, extended_positions, p, n);
+  display_.evaluate(discretization_.control_net(x), p, n);
   SurfaceSnapshot s;
   s.positions.resize(static_cast<std::size_t>(3 * p.rows()));
   s.normals.resize(static_cast<std::size_t>(3 * p.rows()));
@@ -49,9 +50,8 @@ SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::MatrixX3d& extended_po
       s.normals[static_cast<std::size_t>(3 * i + k)] = static_cast<float>(n(i, k));
     }
   if (settings_.wireframe) {
-    s.control.resize(static_cast<std::size_t>(3 * num_real_));
-    for (int v = 0; v < num_real_; ++v)
-      for (int k = 0; k < 3; ++k) s.control[static_cast<std::size_t>(3 * v + k)] = static_cast<float>(extended_positions(v, k));
+    s.control.resize(static_cast<std::size_t>(x.size()));
+    for (Eigen::Index i = 0; i < x.size(); ++i) s.control[static_cast<std::size_t>(i)] = static_cast<float>(x(i));
   }
   return s;
 }

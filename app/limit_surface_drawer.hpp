@@ -1,13 +1,12 @@
-// The adapter between the simulation and the renderer: turns control-mesh positions into plain
-// render::Frame data — the limit surface refined `render.refine` times (positions and normals
-// from a sparse operator built once), the control mesh as an optional wireframe, the scene's
-// colours and a camera (given, or framed once over the bounds of a whole sequence).
+// The adapter between the simulation and the renderer: turns node positions into plain
+// render::Frame data — the surface refined `render.refine` times (positions and normals from the
+// discretisation's display operator, built once), the control mesh as an optional wireframe, the
+// scene's colours and a camera (given, or framed once over the bounds of a whole sequence).
 #pragma once
 
 #include "render/frame.hpp"
 #include "sim/scene/scene.hpp"
-#include "sim/shell/ghost_layer.hpp"
-#include "sim/subdivision/limit_refinement.hpp"
+#include "sim/discretization/discretization.hpp"
 
 #include <Eigen/Core>
 
@@ -22,10 +21,11 @@ struct SurfaceSnapshot {
 
 class LimitSurfaceDrawer {
  public:
-  LimitSurfaceDrawer(const ExtendedMesh& mesh, const RenderSettings& settings, int width, int height);
+  // `discretization` must outlive the drawer.
+  LimitSurfaceDrawer(const Discretization& discretization, const RenderSettings& settings, int width, int height);
 
-  // `extended_positions`: #ext × 3 positions of the control mesh with its ghost layer.
-  SurfaceSnapshot snapshot(const Eigen::MatrixX3d& extended_positions) const;
+  // `x`: node positions (3·#nodes, flat) [m].
+  SurfaceSnapshot snapshot(const Eigen::VectorXd& x) const;
   // Grows the box [lo, hi] to hold the snapshot.
   static void extend_bounds(const SurfaceSnapshot& s, render::Vec3f& lo, render::Vec3f& hi);
   // The scene's camera, or one that frames the box [lo, hi] (viewed slightly from above).
@@ -36,10 +36,10 @@ class LimitSurfaceDrawer {
   int fine_triangles() const { return static_cast<int>(triangles_.size() / 3); }
 
  private:
-  LimitRefinement refinement_;
+  const Discretization& discretization_;
+  SurfaceOperator display_;
   std::vector<unsigned> triangles_;  // fine triangles
-  std::vector<unsigned> edges_;      // control-mesh edges of the real triangles (wireframe)
-  int num_real_ = 0;
+  std::vector<unsigned> edges_;      // edges of the mesh's triangles (wireframe over the nodes)
   RenderSettings settings_;
   int width_, height_;
 };

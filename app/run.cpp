@@ -9,7 +9,8 @@
 #include "render/png_io.hpp"
 #include "render/renderer.hpp"
 #include "sim/mesh/obj_io.hpp"
-#include "sim/shell/ghost_layer.hpp"
+#include "sim/core/layout.hpp"
+#include "sim/discretization/loop_shell.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/static/static_solve.hpp"
 
@@ -119,9 +120,9 @@ void apply_end_option(Scene& scene, const RunOptions& options) {
   if (options.frames) {
     if (scene.analysis != "dynamic") throw std::runtime_error("--frames: only applies to dynamic scenes");
     if (*options.frames < 1) throw std::runtime_error("--frames: must be >= 1");
-    const double end = std::max(scene.dynamic.time.dt, (*options.frames - 1) / scene.dynamic.time.output_fps);
+    const double end = std::max(scene.problem.time.dt, (*options.frames - 1) / scene.problem.time.output_fps);
     log_line("--frames " + std::to_string(*options.frames) + ": simulating to t = " + shortest(end) + " s");
-    scene.dynamic.time.end = end;
+    scene.problem.time.end = end;
   }
   if (!options.end) return;
   const double end = *options.end;
@@ -130,12 +131,12 @@ void apply_end_option(Scene& scene, const RunOptions& options) {
                              scene.analysis + ")");
   if (!(std::isfinite(end) && end > 0))
     throw std::runtime_error("--end: must be a finite number > 0 [s] (got " + shortest(end) + ")");
-  if (end < scene.dynamic.time.dt)
-    throw std::runtime_error("--end: must be >= time.dt = " + shortest(scene.dynamic.time.dt) + " [s] (got " +
+  if (end < scene.problem.time.dt)
+    throw std::runtime_error("--end: must be >= time.dt = " + shortest(scene.problem.time.dt) + " [s] (got " +
                              shortest(end) + ")");
   log_line("--end: simulating to t = " + shortest(end) + " s instead of time.end = " +
-           shortest(scene.dynamic.time.end) + " s");
-  scene.dynamic.time.end = end;
+           shortest(scene.problem.time.end) + " s");
+  scene.problem.time.end = end;
 }
 
 }  // namespace
@@ -164,9 +165,8 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     const std::string comment = "clothsim: deformed limit surface of scene " + scene.name;
     std::optional<render::Image> picture;
     if (options.render) {
-      const ExtendedMesh ext = build_ghost_layer(scene.problem.mesh);
-      const LimitSurfaceDrawer drawer(ext, scene.render, scene.render.width, scene.render.height);
-      const SurfaceSnapshot snapshot = drawer.snapshot(ext.rest + result.extended_displacement);
+      const LimitSurfaceDrawer drawer(*result.discretization, scene.render, scene.render.width, scene.render.height);
+      const SurfaceSnapshot snapshot = drawer.snapshot(result.positions());
       render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
       LimitSurfaceDrawer::extend_bounds(snapshot, lo, hi);
       render::Renderer renderer(scene.render.width, scene.render.height);
@@ -206,6 +206,7 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
     RenderSettings settings;
     if (width > 0) settings.width = width;
     if (height > 0) settings.height = height;
+    std::unique_ptr<LoopShellDiscretization> surface;  // the saved mesh as a Loop control mesh
     std::unique_ptr<LimitSurfaceDrawer> drawer;
     std::vector<SurfaceSnapshot> snapshots;
     render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
@@ -214,11 +215,13 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
       const TriMesh mesh = read_obj(file.string());
       if (!drawer) {
         first_triangles = mesh.triangles;
-        drawer = std::make_unique<LimitSurfaceDrawer>(build_ghost_layer(mesh), settings, settings.width, settings.height);
+        surface = std::make_unique<LoopShellDiscretization>(mesh, std::vector<BoundaryCondition>{}, ShellMaterial{},
+                                                            Quadrature::one_point);
+        drawer = std::make_unique<LimitSurfaceDrawer>(*surface, settings, settings.width, settings.height);
       } else if (mesh.triangles != first_triangles) {
         throw std::runtime_error(file.string() + ": its triangles differ from " + files.front().string());
       }
-      snapshots.push_back(drawer->snapshot(build_ghost_layer(mesh).rest));
+      snapshots.push_back(drawer->snapshot(to_flat(mesh.vertices)));
       LimitSurfaceDrawer::extend_bounds(snapshots.back(), lo, hi);
     }
     render::Renderer renderer(settings.width, settings.height);

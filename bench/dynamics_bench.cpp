@@ -21,7 +21,7 @@ namespace {
 // 0: PCG with block Jacobi, 1: CHOLMOD every step, 2: PCG preconditioned with a refreshed CHOLMOD factor.
 std::unique_ptr<Simulator> make_simulator(int variant) {
   const Scene scene = load_scene(std::string(CLOTHSIM_SOURCE_DIR) + "/scenes/sleeve_compress_2542.json", nullptr);
-  DynamicProblem problem = scene.dynamic;
+  Problem problem = scene.problem;
   problem.solver.type = variant == 1 ? LinearSolverType::cholmod : LinearSolverType::pcg;
   problem.solver.preconditioner = variant == 2 ? PreconditionerType::cholesky : PreconditionerType::block_jacobi;
   return std::make_unique<Simulator>(problem);

@@ -19,7 +19,7 @@ namespace {
 constexpr int kLargest = 128;  // the peak-memory counter is set after this size's solve
 const Eigen::Vector3d kLoad(0.0, 0.0, -1.0);  // [N/m²]
 
-StaticProblem make_problem(const benchmark::State& state) {
+Problem make_problem(const benchmark::State& state) {
   return testing::square_plate(static_cast<int>(state.range(0)), /*clamped=*/false, Quadrature::one_point);
 }
 
@@ -30,7 +30,7 @@ void set_size_counters(benchmark::State& state, const ShellModel& model) {
 
 // (a) ShellModel constructor: ghost layer, DOF map and per-element basis data.
 void BM_PlateSetup(benchmark::State& state) {
-  const StaticProblem p = make_problem(state);
+  const Problem p = make_problem(state);
   for (auto _ : state) {
     ShellModel model(p.mesh, p.material, p.boundary, p.quadrature);
     benchmark::DoNotOptimize(model);
@@ -41,7 +41,7 @@ void BM_PlateSetup(benchmark::State& state) {
 
 // (b) Sparse stiffness assembly and the consistent uniform load.
 void BM_PlateAssembly(benchmark::State& state) {
-  const StaticProblem p = make_problem(state);
+  const Problem p = make_problem(state);
   const ShellModel model(p.mesh, p.material, p.boundary, p.quadrature);
   for (auto _ : state) {
     Eigen::SparseMatrix<double> k = model.stiffness();
@@ -56,7 +56,7 @@ void BM_PlateAssembly(benchmark::State& state) {
 // (c) CHOLMOD analysis + supernodal factorisation + solve (a fresh solver each iteration, as
 // solve_static does).
 void BM_PlateSolve(benchmark::State& state) {
-  const StaticProblem p = make_problem(state);
+  const Problem p = make_problem(state);
   const ShellModel model(p.mesh, p.material, p.boundary, p.quadrature);
   const Eigen::SparseMatrix<double> k = model.stiffness();
   const Eigen::VectorXd f = model.area_load(kLoad);

@@ -71,7 +71,7 @@ std::string format(const char* fmt, double x) {
 }
 
 Row run(const AnalyticPlate& c, Quadrature rule, int divisions) {
-  const StaticProblem p = plate_problem(c, divisions, rule, kSide);
+  const Problem p = plate_problem(c, divisions, rule, kSide);
   const int centre = nearest_vertex(p.mesh, Eigen::Vector3d::Zero());
   const StaticResult r = solve_static(p);
 

@@ -1,10 +1,12 @@
 // Scene loader: parses a scene file with nlohmann::json, checks every key, type and range (the
-// messages carry the file and the key path), builds the mesh, the StaticProblem and, for dynamic
-// scenes, the DynamicProblem.
+// messages carry the file and the key path), builds the mesh, the Problem and, for dynamic
+// scenes, the Problem.
 #include "sim/scene/scene.hpp"
 
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/obj_io.hpp"
+#include "sim/discretization/loop_shell.hpp"
+#include "sim/problem/validate.hpp"
 #include "sim/shell/material_presets.hpp"
 
 #include <Eigen/Geometry>
@@ -515,9 +517,6 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
         bc.motion.push_back(read_motion(r, (*motion)[m], join_index(motion_path, m)));
       if (!bc.motion.empty() && !bc.fix[0] && !bc.fix[1] && !bc.fix[2])
         r.fail(motion_path, "has no effect: the motion drives the fixed components and \"fix\" is empty");
-      if (!bc.motion.empty() && bc.clamped)
-        r.fail(join_key(path, "rotation"), "\"clamped\" cannot be combined with a motion yet (the clamped border "
-                                           "rule is linear in the displacement); use \"free\" (hinged)");
     }
 
     log(path + ": " + std::to_string(bc.vertices.size()) + " vertices");
@@ -533,7 +532,7 @@ std::string describe_snap(const Eigen::MatrixX3d& vertices, int v, const Eigen::
          " m from the requested point)";
 }
 
-void read_loads(const Reader& r, const Json* j, StaticProblem& problem, double* ramp_time, const LogFn& log) {
+void read_loads(const Reader& r, const Json* j, Problem& problem, double* ramp_time, const LogFn& log) {
   if (j == nullptr) return;
   r.check_object(*j, "loads", {"gravity", "surface_load", "pressure", "point_loads", "moments", "ramp_time"});
   if (const Json* ramp = r.find(*j, "ramp_time")) {
@@ -549,10 +548,6 @@ void read_loads(const Reader& r, const Json* j, StaticProblem& problem, double* 
       MomentLoad load;
       load.vertices = read_selection(r, item, path, problem.mesh);
       load.moment = r.vec3(r.require(item, path, "moment"), join_key(path, "moment"));
-      Eigen::VectorXd probe = Eigen::VectorXd::Zero(3 * problem.mesh.num_vertices());
-      if (!add_moment_forces(load, problem.mesh.vertices, probe))
-        r.fail(join_key(path, "select"), "the selected vertices lie on one line parallel to the moment; select at "
-                                         "least two rows of vertices across it");
       log(path + ": " + std::to_string(load.vertices.size()) + " vertices");
       problem.moments.push_back(std::move(load));
     }
@@ -781,11 +776,10 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   // Cheap checks first, the mesh (possibly large) after.
   scene.problem.material = read_material(r, r.find(root, "material"));
   scene.problem.quadrature = read_numerics(r, r.find(root, "numerics"));
-  DynamicProblem& dyn = scene.dynamic;
+  Problem& dyn = scene.problem;
   if (dynamic) {
-    if (!(scene.problem.material.areal_density > 0))
-      r.fail("material", "a dynamic analysis needs a positive areal density (mass) [kg/m²] (got " +
-                             format_number(scene.problem.material.areal_density) + ")");
+    if (const auto issue = find_issue(scene.problem, Analysis::dynamics); issue && issue->key == "material")
+      r.fail(issue->key, issue->message);  // before the (possibly large) mesh is built
     dyn.time = read_time(r, r.find(root, "time"));
     dyn.damping = read_damping(r, r.find(root, "damping"));
     dyn.solver = read_solver(r, r.find(root, "solver"));
@@ -797,7 +791,7 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   scene.render = read_render(r, r.find(root, "render"));
   TriMesh mesh = build_mesh(r, r.require(root, "", "mesh"), file.parent_path(), say);
   try {
-    scene.problem.mesh = prepare_control_mesh(mesh, say);
+    scene.problem.mesh = LoopShellDiscretization::prepare_mesh(mesh, say);
   } catch (const std::exception& e) {
     r.fail("mesh", e.what());
   }
@@ -806,18 +800,8 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   read_loads(r, r.find(root, "loads"), scene.problem, dynamic ? &dyn.ramp_time : nullptr, say);
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
 
-  if (dynamic) {
-    const StaticProblem& p = scene.problem;
-    dyn.mesh = p.mesh;
-    dyn.material = p.material;
-    dyn.boundary = p.boundary;
-    dyn.gravity = p.gravity;
-    dyn.surface_load = p.surface_load;
-    dyn.pressure = p.pressure;
-    dyn.point_loads = p.point_loads;
-    dyn.moments = p.moments;
-    dyn.quadrature = p.quadrature;
-  }
+  if (const auto issue = find_issue(scene.problem, dynamic ? Analysis::dynamics : Analysis::statics))
+    r.fail(issue->key, issue->message);
   return scene;
 }
 }  // namespace

@@ -1,13 +1,13 @@
 // Scene files: loading and validating the JSON description of one analysis (mesh, material,
 // boundary conditions, loads, probes, numerics, and for dynamic scenes time, damping, solver,
-// initial state, scripted motions and output; contract in scenes/README.md) into a
-// StaticProblem and, for dynamic scenes, a DynamicProblem. Every error is a SceneError whose
+// initial state, scripted motions and output; contract in scenes/README.md) into one Problem.
+// Every error is a SceneError whose
 // message starts with the scene file's path and the key path ("scenes/x.json: boundary[0].fix[1]:
 // unknown component ...").
 #pragma once
 
-#include "sim/dynamics/dynamic_problem.hpp"
-#include "sim/static/static_solve.hpp"
+#include "sim/problem/problem.hpp"
+#include "sim/core/log.hpp"
 
 #include <Eigen/Core>
 
@@ -49,13 +49,9 @@ struct Scene {
   std::string description;
   std::filesystem::path file;   // the scene file, as given to load_scene
   std::string analysis;         // "static" or "dynamic"
-  // Mesh (already passed through prepare_control_mesh), material, boundary, loads and
-  // quadrature; filled for every scene (a dynamic scene's boundary motions are ignored here).
-  StaticProblem problem;
-  // Dynamic scenes only (default-constructed for static ones): the same mesh, material,
-  // boundary (with its motions), loads and quadrature as `problem`, plus time, damping, solver,
-  // corotational and initial state.
-  DynamicProblem dynamic;
+  // The problem: mesh (prepared by the discretisation), material, boundary, loads, numerics and,
+  // for dynamic scenes, time, damping, solver, corotational and initial state.
+  Problem problem;
   bool write_obj_frames = false;  // dynamic scenes: "output": {"obj": true}
   RenderSettings render;
   std::vector<Probe> probes;

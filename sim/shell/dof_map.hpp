@@ -20,7 +20,8 @@
 // For a flat plate (N = z) clamped gives the even rule for w and the odd rule in the plane.
 #pragma once
 
-#include "sim/shell/boundary_condition.hpp"
+#include "sim/boundary/boundary_condition.hpp"
+#include "sim/core/layout.hpp"
 #include "sim/shell/ghost_layer.hpp"
 
 #include <Eigen/Core>
@@ -38,8 +39,6 @@ struct GhostMirror {
   double edge_parameter = 0.5;  // the foot of the ghost on the edge: (1 − s) x_a + s x_b
 };
 GhostMirror ghost_mirror(const ExtendedMesh& ext, int ghost);
-
-enum class DofStatus : unsigned char { free, fixed, dependent };
 
 // Σ weight · u[dof] over free and fixed real components, dof = 3·vertex + component (fixed
 // components carry their prescribed displacement: zero in a static analysis, a scripted motion

@@ -9,7 +9,7 @@
 #pragma once
 
 #include "sim/mesh/mesh.hpp"
-#include "sim/shell/boundary_condition.hpp"
+#include "sim/boundary/boundary_condition.hpp"
 #include "sim/shell/dof_map.hpp"
 #include "sim/shell/element.hpp"
 #include "sim/shell/ghost_layer.hpp"
@@ -99,6 +99,8 @@ class ShellModel {
   Eigen::VectorXd area_load(const Eigen::Vector3d& q) const;
   // Pressure p [N/m²] along the reference surface's unit normal a₃: f_I = ∫ N_I p a₃ dA.
   Eigen::VectorXd pressure_load(double p) const;
+  // ∫ N_I t(x) dA for a traction t [N/m²] given at each quadrature point's reference geometry.
+  Eigen::VectorXd surface_traction_load(const std::function<Eigen::Vector3d(const SurfacePoint&)>& traction) const;
   // A force [N] at the limit point of real vertex v, spread with the limit-mask weights.
   Eigen::VectorXd point_load(int v, const Eigen::Vector3d& force) const;
 
@@ -109,8 +111,6 @@ class ShellModel {
  private:
   // Folds a patch-local vector (3·#patch) into the global vector.
   void scatter_vector(const ShellElement& el, const Eigen::VectorXd& local, Eigen::VectorXd& global) const;
-  // ∫ N_I t(x) dA for a traction t [N/m²] given at each quadrature point's reference geometry.
-  Eigen::VectorXd surface_traction_load(const std::function<Eigen::Vector3d(const SurfacePoint&)>& traction) const;
   void build_pattern();
   void build_colors();
   template <class Matrix>

@@ -31,13 +31,7 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-// Surface displacement at the points from the extended-mesh displacement (#ext × 3).
-Eigen::MatrixX3d sample_displacement(const ExtendedMesh& ext, const std::vector<SurfacePoint>& points,
-                                     const Eigen::MatrixX3d& extended_displacement) {
-  return limit_sampling_matrix(ext, points) * extended_displacement;
-}
-
-MethodRun solve_loop_static(StaticProblem problem, Quadrature rule, const std::vector<SurfacePoint>& points) {
+MethodRun solve_loop_static(Problem problem, Quadrature rule, const std::vector<SurfaceSample>& points) {
   problem.quadrature = rule;
   MethodRun run;
   const Clock::time_point start = Clock::now();
@@ -46,24 +40,26 @@ MethodRun solve_loop_static(StaticProblem problem, Quadrature rule, const std::v
   run.vertices = problem.mesh.num_vertices();
   run.dofs = result.dofs;
   run.solver_iterations = 1;
-  run.displacements = {sample_displacement(build_ghost_layer(problem.mesh), points, result.extended_displacement)};
+  const Discretization& d = *result.discretization;
+  const SurfaceOperator sampling = d.samples(points);
+  run.displacements = {d.surface_positions(sampling, result.positions()) - d.surface_positions(sampling, d.rest())};
   return run;
 }
 
-MethodRun run_loop_dynamic(DynamicProblem problem, Quadrature rule, const std::vector<SurfacePoint>& points,
+MethodRun run_loop_dynamic(Problem problem, Quadrature rule, const std::vector<SurfaceSample>& points,
                            const std::vector<double>& times) {
   if (times.empty()) throw std::invalid_argument("run_loop_dynamic: no sample times");
   problem.quadrature = rule;
   problem.time.end = times.back();
   const double slack = 1e-9 * problem.time.dt;
   MethodRun run;
-  std::vector<Eigen::MatrixX3d> snapshots;  // extended-mesh positions at the sample times [m]
+  std::vector<Eigen::VectorXd> snapshots;  // node positions at the sample times [m]
   const Clock::time_point start = Clock::now();
   Simulator sim(problem);
   size_t next = 0;
   auto take_due_samples = [&] {
     for (; next < times.size() && sim.state().t >= times[next] - slack; ++next)
-      snapshots.push_back(sim.extended_positions());
+      snapshots.push_back(sim.state().x);
   };
   for (take_due_samples(); next < times.size(); take_due_samples()) {
     const StepStats stats = sim.step();
@@ -71,11 +67,13 @@ MethodRun run_loop_dynamic(DynamicProblem problem, Quadrature rule, const std::v
     ++run.steps;
   }
   run.wall_seconds = seconds_since(start);
-  const ExtendedMesh& ext = sim.extended_mesh();
+  const Discretization& d = sim.discretization();
   run.vertices = sim.num_vertices();
-  run.dofs = DofMap(ext, problem.boundary).num_free();
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> sampling = limit_sampling_matrix(ext, points);
-  for (const Eigen::MatrixX3d& x : snapshots) run.displacements.push_back(sampling * (x - ext.rest));
+  run.dofs = 0;
+  for (int dof = 0; dof < 3 * d.num_nodes(); ++dof) run.dofs += d.status(dof) == DofStatus::free;
+  const SurfaceOperator sampling = d.samples(points);
+  const Eigen::MatrixX3d rest = d.surface_positions(sampling, d.rest());
+  for (const Eigen::VectorXd& x : snapshots) run.displacements.push_back(d.surface_positions(sampling, x) - rest);
   return run;
 }
 
@@ -160,13 +158,13 @@ class SleeveScene {
                                                      "full \"cylinder\" primitive");
   }
 
-  DynamicProblem problem(const SleeveMesh& m, double dt) const {
+  Problem problem(const SleeveMesh& m, double dt) const {
     nlohmann::json j = json_;
     j["mesh"]["segments"] = m.segments;
     j["mesh"]["rings"] = m.rings;
     j["time"]["dt"] = dt;
     j["time"]["end"] = all_sample_times(case_).back();
-    return load_scene_text(j.dump(2), case_.scene, LogFn()).dynamic;
+    return load_scene_text(j.dump(2), case_.scene, LogFn()).problem;
   }
 
  private:
@@ -195,8 +193,8 @@ const Method& find_method(const std::vector<Method>& methods, const std::vector<
 constexpr int kStaticRepeats = 5;
 constexpr double kStaticRepeatSeconds = 0.25;
 
-MethodRun solve_static_timed(const Method& method, const StaticProblem& problem,
-                             const std::vector<SurfacePoint>& points) {
+MethodRun solve_static_timed(const Method& method, const Problem& problem,
+                             const std::vector<SurfaceSample>& points) {
   MethodRun run = method.solve_static(problem, points);
   double total = run.wall_seconds, best = run.wall_seconds;
   for (int k = 1; k < kStaticRepeats && total + best < kStaticRepeatSeconds; ++k) {
@@ -217,9 +215,9 @@ class StudyRunner {
       if (!method.solve_static) continue;
       for (int n : c.divisions) {
         // The method sets its own quadrature; the problem carries the default.
-        const StaticProblem problem = plate_problem(c.plate, n, Quadrature::one_point);
+        const Problem problem = plate_problem(c.plate, n, Quadrature::one_point);
         const Eigen::MatrixX2d chart = problem.mesh.vertices.leftCols<2>();  // (x, y) [m]
-        const std::vector<SurfacePoint> centre =
+        const std::vector<SurfaceSample> centre =
             locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
         warm_up(method, problem, centre);
         ConvergenceRow row;
@@ -309,7 +307,7 @@ class StudyRunner {
  private:
   // One untimed solve before a method's first timed static run, so that one-time start-up
   // (thread pools, allocator growth) is not charged to the first row.
-  void warm_up(const Method& method, const StaticProblem& problem, const std::vector<SurfacePoint>& points) {
+  void warm_up(const Method& method, const Problem& problem, const std::vector<SurfaceSample>& points) {
     if (!warmed_up_.insert(method.name).second) return;
     try {
       method.solve_static(problem, points);
@@ -345,9 +343,9 @@ class StudyRunner {
     const std::string key = method.name + " " + sleeve_setting(m, dt);
     if (auto it = cache_.find(key); it != cache_.end()) return it->second;
     Outcome o;
-    const DynamicProblem problem = scene.problem(m, dt);
+    const Problem problem = scene.problem(m, dt);
     o.h = mesh_size(problem.mesh);
-    const std::vector<SurfacePoint> points =
+    const std::vector<SurfaceSample> points =
         locate_points(problem.mesh.triangles, cylinder_chart(problem.mesh.vertices),
                       cylinder_parameter_grid(c.grid_theta, c.grid_s), 2 * std::numbers::pi);
     try {
@@ -388,10 +386,10 @@ Method loop_subdivision_method(const std::string& name, Quadrature rule) {
   Method m;
   m.name = name;
   m.description = std::string("Loop subdivision shell element, ") + to_string(rule) + " quadrature";
-  m.solve_static = [rule](const StaticProblem& problem, const std::vector<SurfacePoint>& points) {
+  m.solve_static = [rule](const Problem& problem, const std::vector<SurfaceSample>& points) {
     return solve_loop_static(problem, rule, points);
   };
-  m.run_dynamic = [rule](const DynamicProblem& problem, const std::vector<SurfacePoint>& points,
+  m.run_dynamic = [rule](const Problem& problem, const std::vector<SurfaceSample>& points,
                          const std::vector<double>& times) { return run_loop_dynamic(problem, rule, points, times); };
   return m;
 }

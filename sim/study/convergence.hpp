@@ -28,7 +28,8 @@
 // method.
 #pragma once
 
-#include "sim/dynamics/dynamic_problem.hpp"
+#include "sim/core/log.hpp"
+#include "sim/problem/problem.hpp"
 #include "sim/shell/quadrature.hpp"
 #include "sim/static/static_solve.hpp"
 #include "sim/study/plates.hpp"
@@ -66,8 +67,8 @@ struct MethodRun {
 struct Method {
   std::string name;         // the CSV's "method" column, e.g. "loop_one_point"
   std::string description;  // one line for logs and docs
-  std::function<MethodRun(const StaticProblem& problem, const std::vector<SurfacePoint>& points)> solve_static;
-  std::function<MethodRun(const DynamicProblem& problem, const std::vector<SurfacePoint>& points,
+  std::function<MethodRun(const Problem& problem, const std::vector<SurfaceSample>& points)> solve_static;
+  std::function<MethodRun(const Problem& problem, const std::vector<SurfaceSample>& points,
                           const std::vector<double>& times)>
       run_dynamic;
 };

@@ -9,8 +9,8 @@ namespace clothsim {
 
 int nearest_vertex(const TriMesh& mesh, const Eigen::Vector3d& point) { return nearest_vertex(mesh.vertices, point); }
 
-StaticProblem square_plate(int divisions, bool clamped, Quadrature rule, double side) {
-  StaticProblem p;
+Problem square_plate(int divisions, bool clamped, Quadrature rule, double side) {
+  Problem p;
   p.mesh = make_grid(side, side, divisions, divisions);
   p.material = ShellMaterial::from_solid(1e7, 0.3, 0.01, 1000);
   const double h = side / 2 - 1e-9 * side;
@@ -22,13 +22,13 @@ StaticProblem square_plate(int divisions, bool clamped, Quadrature rule, double 
   return p;
 }
 
-double plate_rigidity(const StaticProblem& problem) {
+double plate_rigidity(const Problem& problem) {
   const double nu = problem.material.poisson_ratio;
   return problem.material.bending_rigidity / (1 - nu * nu);
 }
 
-StaticProblem plate_problem(const AnalyticPlate& plate, int divisions, Quadrature rule, double side) {
-  StaticProblem p = square_plate(divisions, plate.clamped, rule, side);
+Problem plate_problem(const AnalyticPlate& plate, int divisions, Quadrature rule, double side) {
+  Problem p = square_plate(divisions, plate.clamped, rule, side);
   if (plate.point_load)
     p.point_loads.push_back({nearest_vertex(p.mesh, Eigen::Vector3d::Zero()), Eigen::Vector3d(0, 0, -kPlateForce)});
   else
@@ -36,7 +36,7 @@ StaticProblem plate_problem(const AnalyticPlate& plate, int divisions, Quadratur
   return p;
 }
 
-double plate_reference_deflection(const AnalyticPlate& plate, const StaticProblem& problem, double side) {
+double plate_reference_deflection(const AnalyticPlate& plate, const Problem& problem, double side) {
   const double d = plate_rigidity(problem);
   return plate.point_load ? plate.coefficient * kPlateForce * side * side / d
                           : plate.coefficient * kPlatePressure * std::pow(side, 4) / d;

@@ -61,17 +61,17 @@ int nearest_vertex(const TriMesh& mesh, const Eigen::Vector3d& point);
 // Unloaded square plate: side `side` [m], divisions × divisions cells (make_grid), E = 1e7 Pa,
 // ν = 0.3, t = 0.01 m, all border vertices hinged (clamped = false) or clamped, the given
 // quadrature rule.
-StaticProblem square_plate(int divisions, bool clamped, Quadrature rule, double side = 1.0);
+Problem square_plate(int divisions, bool clamped, Quadrature rule, double side = 1.0);
 
 // Flexural rigidity D = E t³ / (12 (1 − ν²)) of the problem's material [N·m].
-double plate_rigidity(const StaticProblem& problem);
+double plate_rigidity(const Problem& problem);
 
 // square_plate with the case's load: q = kPlatePressure on the whole plate, or P = kPlateForce
 // at the control vertex nearest to the centre (the vertex at the centre for even divisions).
-StaticProblem plate_problem(const AnalyticPlate& plate, int divisions, Quadrature rule, double side = 1.0);
+Problem plate_problem(const AnalyticPlate& plate, int divisions, Quadrature rule, double side = 1.0);
 
 // The analytic downward centre deflection [m] of `plate` for the material and side of
 // `problem` (as built by plate_problem with that side).
-double plate_reference_deflection(const AnalyticPlate& plate, const StaticProblem& problem, double side = 1.0);
+double plate_reference_deflection(const AnalyticPlate& plate, const Problem& problem, double side = 1.0);
 
 }  // namespace clothsim

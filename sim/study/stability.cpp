@@ -241,7 +241,7 @@ void simulate(const std::string& json, const std::string& name, const std::strin
   const auto t0 = std::chrono::steady_clock::now();
   const Scene scene = load_scene_text(json, name + ".json", LogFn());
   if (scene.analysis != "dynamic") throw std::runtime_error(name + ": the case is not a dynamic scene");
-  const DynamicProblem& problem = scene.dynamic;
+  const Problem& problem = scene.problem;
   Simulator sim(problem);
   r.vertices = sim.num_vertices();
   r.dt = problem.time.dt;

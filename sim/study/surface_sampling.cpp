@@ -1,6 +1,5 @@
 #include "sim/study/surface_sampling.hpp"
 
-#include "sim/subdivision/patch.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +24,7 @@ bool barycentric(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen
 
 }  // namespace
 
-std::vector<SurfacePoint> locate_points(const std::vector<Triangle>& triangles, const Eigen::MatrixX2d& chart,
+std::vector<SurfaceSample> locate_points(const std::vector<Triangle>& triangles, const Eigen::MatrixX2d& chart,
                                         const Eigen::MatrixX2d& targets, double period) {
   constexpr double kTolerance = 1e-10;
   // Chart triangles, unwrapped across the seam of a periodic first coordinate.
@@ -36,7 +35,7 @@ std::vector<SurfacePoint> locate_points(const std::vector<Triangle>& triangles, 
       if (period > 0 && k > 0) q.x() -= period * std::round((q.x() - corners[t][0].x()) / period);
       corners[t][k] = q;
     }
-  std::vector<SurfacePoint> out;
+  std::vector<SurfaceSample> out;
   out.reserve(static_cast<size_t>(targets.rows()));
   for (Eigen::Index i = 0; i < targets.rows(); ++i) {
     const Eigen::Vector2d target = targets.row(i).transpose();
@@ -87,24 +86,6 @@ Eigen::MatrixX2d cylinder_parameter_grid(int n_theta, int n_s) {
       grid(row, 1) = (j + 0.5) / n_s;
     }
   return grid;
-}
-
-Eigen::SparseMatrix<double, Eigen::RowMajor> limit_sampling_matrix(const ExtendedMesh& ext,
-                                                                   const std::vector<SurfacePoint>& points) {
-  std::vector<Eigen::Triplet<double>> entries;
-  for (size_t p = 0; p < points.size(); ++p) {
-    const SurfacePoint& sp = points[p];
-    if (sp.triangle < 0 || sp.triangle >= ext.num_real_triangles)
-      throw std::invalid_argument("limit_sampling_matrix: point " + std::to_string(p) + " names triangle " +
-                                  std::to_string(sp.triangle) + ", not a triangle of the control mesh");
-    const PatchEvaluation pe = evaluate_patch(ext.topology, ext.triangles[static_cast<size_t>(sp.triangle)], sp.v, sp.w);
-    for (size_t k = 0; k < pe.vertices.size(); ++k)
-      if (pe.basis(0, static_cast<Eigen::Index>(k)) != 0.0)
-        entries.emplace_back(static_cast<int>(p), pe.vertices[k], pe.basis(0, static_cast<Eigen::Index>(k)));
-  }
-  Eigen::SparseMatrix<double, Eigen::RowMajor> m(static_cast<Eigen::Index>(points.size()), ext.num_vertices());
-  m.setFromTriplets(entries.begin(), entries.end());
-  return m;
 }
 
 namespace {

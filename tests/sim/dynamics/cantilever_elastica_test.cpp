@@ -68,7 +68,7 @@ struct CantileverResult {
 
 CantileverResult load_cantilever(double alpha, int along, int across) {
   const double length = 0.2, width = 0.02, rigidity = 1e-4;  // bending rigidity per unit width [N·m]
-  DynamicProblem p;
+  Problem p;
   // Measured: stretched cells bias the one-point element (80 × 4 cells: 0.24–0.26 % of L too far,
   // 20 × 4: 0.9–1.5 % short), square ones converge (20 × 2: ≤ 0.72 %, 40 × 4: ≤ 0.06 %,
   // 80 × 8: ≤ 0.03 %).

@@ -12,9 +12,9 @@
 namespace clothsim {
 namespace {
 
-DynamicProblem tipped_sleeve() {
+Problem tipped_sleeve() {
   const double length = 0.2;
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_cylinder(0.05, length, 20, 13);
   p.material = *material_preset("cotton");
   BoundaryCondition top;
@@ -37,7 +37,7 @@ DynamicProblem tipped_sleeve() {
 }
 
 TEST(CholeskyPreconditioned, MatchesTheDirectSolveAndReusesTheFactor) {
-  DynamicProblem p = tipped_sleeve();
+  Problem p = tipped_sleeve();
   p.solver.type = LinearSolverType::cholmod;
   Simulator direct(p);
   p.solver.type = LinearSolverType::pcg;

@@ -1,7 +1,7 @@
 // Corotational dynamics: free fall against the closed form of implicit Euler, a spinning free
 // sleeve staying undeformed, energy that never rises without external work, conserved linear
 // momentum, scripted vertices on their motion, forces = −∇ energy for frozen rotations.
-#include "sim/dynamics/corotation.hpp"
+#include "sim/corotation/corotational_elements.hpp"
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/generators.hpp"
 
@@ -19,8 +19,8 @@
 namespace clothsim {
 namespace {
 
-DynamicProblem free_sleeve(double stretch = 1e5) {
-  DynamicProblem p;
+Problem free_sleeve(double stretch = 1e5) {
+  Problem p;
   p.mesh = make_cylinder(0.05, 0.2, 16, 9);
   p.material.stretch_modulus = stretch;
   p.material.bending_rigidity = 1e-4;
@@ -34,7 +34,7 @@ DynamicProblem free_sleeve(double stretch = 1e5) {
 }
 
 // The vertices of the sleeve's two rims (y = 0 and y = 0.2 m), as boundary conditions without motion.
-std::pair<BoundaryCondition, BoundaryCondition> rims(const DynamicProblem& p) {
+std::pair<BoundaryCondition, BoundaryCondition> rims(const Problem& p) {
   BoundaryCondition bottom, top;
   for (int v = 0; v < p.mesh.num_vertices(); ++v) {
     if (p.mesh.vertices(v, 1) < 1e-9) bottom.vertices.push_back(v);
@@ -60,7 +60,7 @@ double rigid_residual(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3d& x) {
 }
 
 TEST(Dynamics, FreeFallMatchesImplicitEulerClosedForm) {
-  DynamicProblem p = free_sleeve();
+  Problem p = free_sleeve();
   p.gravity = Eigen::Vector3d(0, -9.81, 0);
   p.time.end = 0.05;
   for (LinearSolverType solver : {LinearSolverType::pcg, LinearSolverType::cholmod}) {
@@ -83,7 +83,7 @@ TEST(Dynamics, SpinningFreeSleeveStaysUndeformed) {
   // = 2.5e-7, is below the tolerance). With one linear solve per step the rotations lag by a
   // step and the straight-line update drifts: measured 2.2e-5. Three Newton iterations
   // (rotations re-extracted at the end of the step): 1.1e-7.
-  DynamicProblem p = free_sleeve();
+  Problem p = free_sleeve();
   p.mesh = make_cylinder(0.05, 0.2, 12, 7);
   p.initial.angular_velocity = Eigen::Vector3d(0, 10.0, 0);
   p.initial.center = Eigen::Vector3d(0, 0.1, 0);
@@ -99,7 +99,7 @@ TEST(Dynamics, SpinningFreeSleeveStaysUndeformed) {
 }
 
 TEST(Dynamics, LinearElementDistortsUnderTheSameSpin) {
-  DynamicProblem p = free_sleeve();
+  Problem p = free_sleeve();
   p.mesh = make_cylinder(0.05, 0.2, 12, 7);
   p.initial.angular_velocity = Eigen::Vector3d(0, 10.0, 0);
   p.initial.center = Eigen::Vector3d(0, 0.1, 0);
@@ -112,7 +112,7 @@ TEST(Dynamics, LinearElementDistortsUnderTheSameSpin) {
 }
 
 TEST(Dynamics, LinearMomentumIsConservedWithoutExternalForces) {
-  DynamicProblem p = free_sleeve(5000);
+  Problem p = free_sleeve(5000);
   p.initial.velocity = Eigen::Vector3d(0.1, -0.2, 0.05);
   p.initial.angular_velocity = Eigen::Vector3d(2.0, 5.0, -3.0);  // oblique: the sleeve deforms
   p.time.end = 0.2;
@@ -132,7 +132,7 @@ TEST(Dynamics, LinearMomentumIsConservedWithoutExternalForces) {
 TEST(Dynamics, TotalEnergyNeverRisesWithoutExternalWork) {
   // A strip hinged along one end, thrown into a flapping motion by an initial rotation about
   // the hinge line; the fixed supports do no work.
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_grid(0.3, 0.1, 12, 4);
   p.material.stretch_modulus = 5000;
   p.material.bending_rigidity = 1e-4;
@@ -166,7 +166,7 @@ TEST(Dynamics, TotalEnergyNeverRisesWithoutExternalWork) {
 }
 
 TEST(Dynamics, ScriptedVerticesFollowTheirMotionExactly) {
-  DynamicProblem p = free_sleeve(5000);
+  Problem p = free_sleeve(5000);
   auto [bottom, top] = rims(p);
   Motion twist;
   twist.type = Motion::Type::rotate;
@@ -204,7 +204,7 @@ TEST(Dynamics, ScriptedVerticesFollowTheirMotionExactly) {
 // steady rate, the regime it is meant for; measured 1057 instead of 1214 iterations, positions
 // equal to 2e-16 m).
 TEST(Dynamics, ExtrapolatedStartSavesIterationsNotAccuracy) {
-  DynamicProblem p = free_sleeve(5000);
+  Problem p = free_sleeve(5000);
   p.solver.tolerance = 1e-10;
   auto [bottom, top] = rims(p);
   Motion push;
@@ -229,7 +229,7 @@ TEST(Dynamics, ExtrapolatedStartSavesIterationsNotAccuracy) {
 }
 
 // The simulator keeps what it needs of the problem: scripted motions still drive the rim after
-// the caller's DynamicProblem is gone (they were once read through pointers into it).
+// the caller's Problem is gone (they were once read through pointers into it).
 TEST(Dynamics, ScriptedMotionOutlivesTheCallersProblem) {
   std::vector<int> top_vertices;
   Eigen::MatrixX3d rest;
@@ -240,7 +240,7 @@ TEST(Dynamics, ScriptedMotionOutlivesTheCallersProblem) {
   push.start = 0.0;
   push.end = 0.1;
   {
-    auto p = std::make_unique<DynamicProblem>(free_sleeve(5000));
+    auto p = std::make_unique<Problem>(free_sleeve(5000));
     BoundaryCondition top;
     for (int v = 0; v < p->mesh.num_vertices(); ++v)
       if (p->mesh.vertices(v, 1) > 0.2 - 1e-9) top.vertices.push_back(v);

@@ -21,7 +21,7 @@ struct StripResult {
 
 StripResult bend_strip(double theta, int along) {
   const double length = 0.2, width = 0.02, rigidity = 1e-4;  // bending rigidity per unit width [N·m]
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_grid(length, width, along, 4);
   p.material.stretch_modulus = 1e4;
   p.material.bending_rigidity = rigidity;

@@ -3,7 +3,7 @@
 // (with the rotations re-extracted) never gain energy that no work explains; held supports do no
 // work; the principal Green–Lagrange strain of the limit surface is exact for uniform stretches
 // and zero for rigid motions.
-#include "sim/dynamics/corotation.hpp"
+#include "sim/corotation/corotational_elements.hpp"
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/generators.hpp"
 
@@ -62,7 +62,7 @@ TEST(EnergyAccounting, SupportPulledSlowlyStoresItsWorkAsElasticEnergy) {
   // 1 s (quasi-static: the slowest membrane period is ~1 ms). Implicit Euler dissipates only
   // O(h) of the work, so the stored energy equals the boundary work within 1 %, and both match
   // the bar estimate ½ (E t · b / L) δ² within the Poisson effect of the held edges.
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_grid(0.2, 0.05, 16, 4);
   p.material = cloth();
   BoundaryCondition left, right;
@@ -98,7 +98,7 @@ TEST(EnergyAccounting, RimTurnedSlowlyStoresItsWorkAsElasticEnergy) {
   // element rotations changing. Bending rigidity 1e-3 N·m keeps the shear strain (3e-3 at the
   // end) below the wrinkling threshold — a buckling snap would dissipate energy on its own.
   // Stored energy = boundary work within 1 %.
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_cylinder(0.05, 0.2, 12, 7);
   p.material = cloth();
   p.material.bending_rigidity = 1e-3;
@@ -128,7 +128,7 @@ TEST(EnergyAccounting, FreeFallLosesExactlyImplicitEulersDissipation) {
   // No elastic energy: each step, E − W_ext changes by −½ Σ m (h g)² (implicit Euler's
   // ½ |Δv|²_M), to round-off (the difference of two energies that grow as t²: 1e-6 of the
   // step's dissipation after 100 steps); nothing ever rises.
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_cylinder(0.05, 0.2, 12, 7);
   p.material = cloth();
   p.gravity = Eigen::Vector3d(0, -9.81, 0);
@@ -153,7 +153,7 @@ TEST(EnergyAccounting, FreeSpinGainsNothingWithTheRotationsReextracted) {
   // vertices move along chords and the first step stretches it by ≈ (ωh)²/2 (a small rise);
   // with a second solve, rotations re-extracted at the end of the step, the total energy never
   // rises above round-off.
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_cylinder(0.05, 0.2, 12, 7);
   p.material = cloth();
   p.initial.angular_velocity = Eigen::Vector3d(10, 0, 0);
@@ -175,7 +175,7 @@ TEST(EnergyAccounting, FreeSpinGainsNothingWithTheRotationsReextracted) {
 }
 
 TEST(EnergyAccounting, HeldSupportsDoNoWork) {
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_grid(0.3, 0.1, 12, 4);
   p.material = cloth();
   BoundaryCondition hinge;

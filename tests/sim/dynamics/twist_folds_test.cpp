@@ -25,7 +25,7 @@ struct Wave {
 Wave mid_height_wave(double twist_deg, bool sliding_rim = true) {
   const double radius = 0.05, length = 0.2;
   const int segments = 26, rings = 19;
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_cylinder(radius, length, segments, rings);
   p.material = *material_preset("cotton");
   BoundaryCondition bottom, top;

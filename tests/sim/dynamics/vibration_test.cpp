@@ -61,7 +61,7 @@ struct Vibration {
 };
 
 // The signal: z-displacement of `probe`, one sample per step.
-std::vector<double> run(const DynamicProblem& p, int probe) {
+std::vector<double> run(const Problem& p, int probe) {
   Simulator sim(p);
   std::vector<double> w;
   w.reserve(sim.num_steps());
@@ -74,7 +74,7 @@ std::vector<double> run(const DynamicProblem& p, int probe) {
 
 Vibration simply_supported_plate(int n, DampingSettings damping = {}) {
   const double a = 1.0, t = 0.01, rho = 1000.0, young = 1e7, nu = 0.3;
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_grid(a, a, n, n);
   p.material = ShellMaterial::from_solid(young, nu, t, rho);
   BoundaryCondition edge;  // hinged: displacements held, rotation free
@@ -98,7 +98,7 @@ Vibration simply_supported_plate(int n, DampingSettings damping = {}) {
 
 Vibration cantilever(int along, int across) {
   const double length = 0.2, width = 0.02, rigidity = 1e-4, areal_density = 0.1;  // B [N·m], ρh [kg/m²]
-  DynamicProblem p;
+  Problem p;
   p.mesh = make_grid(length, width, along, across);
   p.material.stretch_modulus = 1e4;
   p.material.bending_rigidity = rigidity;
@@ -140,7 +140,7 @@ TEST(Vibration, ShippedPlateVibrationSceneMatchesTheFundamentalFrequency) {
   const Scene scene = load_scene(std::string(CLOTHSIM_SOURCE_DIR) + "/scenes/plate_vibration.json", nullptr);
   const double d = 1e7 * 1e-6 / (12 * (1 - 0.3 * 0.3));
   const double omega = 2 * std::numbers::pi * std::numbers::pi * std::sqrt(d / (1000 * 0.01));
-  const DynamicProblem& p = scene.dynamic;
+  const Problem& p = scene.problem;
   const Mode m = fitted_mode(run(p, scene.probes.at(0).vertex), p.time.dt, static_cast<std::size_t>(1.0 / p.time.dt));
   std::printf("plate_vibration.json: omega %.6f rad/s, reference %.6f, error %+.3f %%\n", m.omega, omega,
               100 * (m.omega / omega - 1));

@@ -450,7 +450,7 @@ const char* const kDynamicFull = R"({
 TEST_F(SceneLoader, DynamicKeysParsed) {
   const Scene s = load(kDynamicFull);
   EXPECT_EQ(s.analysis, "dynamic");
-  const DynamicProblem& d = s.dynamic;
+  const Problem& d = s.problem;
   EXPECT_DOUBLE_EQ(d.time.dt, 0.002);
   EXPECT_DOUBLE_EQ(d.time.end, 2.0);
   EXPECT_DOUBLE_EQ(d.time.output_fps, 25.0);
@@ -503,7 +503,7 @@ TEST_F(SceneLoader, DynamicDefaults) {
   const Scene s = load(std::string(R"({"analysis": "dynamic", )") + kGrid4 +
                        R"(, "boundary": [{"select": {"box": [[-1, -0.51, -1], [1, -0.49, 1]]},
       "motion": [{"type": "rotate", "axis": [0, 0, 2], "angle_deg": 30, "start": 0.5, "end": 0.5}]}]})");
-  const DynamicProblem& d = s.dynamic;
+  const Problem& d = s.problem;
   EXPECT_DOUBLE_EQ(d.time.dt, 0.001);
   EXPECT_DOUBLE_EQ(d.time.end, 1.0);
   EXPECT_DOUBLE_EQ(d.time.output_fps, 30.0);
@@ -531,11 +531,10 @@ TEST_F(SceneLoader, DynamicDefaults) {
   // "output": {} and "obj": false leave frames off; the default material has mass.
   EXPECT_FALSE(load(std::string(R"({"analysis": "dynamic", "output": {}, )") + kGrid4 + "}").write_obj_frames);
   EXPECT_FALSE(load(std::string(R"({"analysis": "dynamic", "output": {"obj": false}, )") + kGrid4 + "}").write_obj_frames);
-  EXPECT_GT(load(std::string(R"({"analysis": "dynamic", )") + kGrid4 + "}").dynamic.material.areal_density, 0.0);
+  EXPECT_GT(load(std::string(R"({"analysis": "dynamic", )") + kGrid4 + "}").problem.material.areal_density, 0.0);
 
-  // A static scene leaves the dynamic part at its defaults.
+  // A static scene writes no OBJ frames.
   const Scene t = load(std::string("{") + kGrid4 + "}");
-  EXPECT_EQ(t.dynamic.mesh.num_vertices(), 0);
   EXPECT_FALSE(t.write_obj_frames);
 }
 
@@ -691,7 +690,7 @@ TEST_F(SceneLoader, ShippedSleeveScenes) {
                                              {"fig8_thick_stiff", 780, 1500, 0.001, 1.5, "rotate"}}) {
     SCOPED_TRACE(e.name);
     const Scene s = load_scene(scenes / (e.name + ".json"), nullptr);
-    const DynamicProblem& d = s.dynamic;
+    const Problem& d = s.problem;
     EXPECT_EQ(s.analysis, "dynamic");
     EXPECT_TRUE(s.write_obj_frames);
     EXPECT_EQ(d.mesh.num_vertices(), e.vertices);
@@ -737,7 +736,7 @@ TEST_F(SceneLoader, ShippedSleeveScenes) {
   }
 
   const ShellMaterial cotton = *material_preset("cotton");
-  auto material = [&](const std::string& name) { return load_scene(scenes / (name + ".json"), nullptr).dynamic.material; };
+  auto material = [&](const std::string& name) { return load_scene(scenes / (name + ".json"), nullptr).problem.material; };
   EXPECT_DOUBLE_EQ(material("sleeve_gravity").bending_rigidity, cotton.bending_rigidity);
   EXPECT_DOUBLE_EQ(material("metal_compress").stretch_modulus, 1e5);
   const ShellMaterial thin = material("fig8_thin"), thick = material("fig8_thick"), stiff = material("fig8_thick_stiff");

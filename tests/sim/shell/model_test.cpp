@@ -87,7 +87,7 @@ TEST(LoopSubdivision, RefinedMeshHasTheSameLimitPoints) {
 TEST(PrepareControlMesh, RefinesOnceWhenATriangleHasTwoIrregularVertices) {
   std::vector<std::string> log;
   const TriMesh coarse = make_grid(1.0, 1.0, 1, 1);  // every vertex is a corner
-  const TriMesh prepared = prepare_control_mesh(coarse, [&](const std::string& line) { log.push_back(line); });
+  const TriMesh prepared = LoopShellDiscretization::prepare_mesh(coarse, [&](const std::string& line) { log.push_back(line); });
   EXPECT_EQ(prepared.num_triangles(), 8);
   ASSERT_EQ(log.size(), 1u);
   EXPECT_NE(log[0].find("refined once by Loop subdivision"), std::string::npos) << log[0];
@@ -97,7 +97,7 @@ TEST(PrepareControlMesh, RefinesOnceWhenATriangleHasTwoIrregularVertices) {
   // A regular grid is left alone.
   log.clear();
   const TriMesh grid = make_grid(1.0, 1.0, 8, 8);
-  EXPECT_EQ(prepare_control_mesh(grid, [&](const std::string& line) { log.push_back(line); }).num_vertices(),
+  EXPECT_EQ(LoopShellDiscretization::prepare_mesh(grid, [&](const std::string& line) { log.push_back(line); }).num_vertices(),
             grid.num_vertices());
   EXPECT_TRUE(log.empty());
 }

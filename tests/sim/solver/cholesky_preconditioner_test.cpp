@@ -16,7 +16,7 @@ namespace clothsim {
 namespace {
 
 Eigen::SparseMatrix<double> plate_matrix(int divisions) {
-  const StaticProblem p = square_plate(divisions, /*clamped=*/true, Quadrature::one_point);
+  const Problem p = square_plate(divisions, /*clamped=*/true, Quadrature::one_point);
   const ShellModel model(p.mesh, p.material, p.boundary, p.quadrature);
   Eigen::SparseMatrix<double> k = model.stiffness();
   model.restrict_to_free(k);
@@ -85,7 +85,7 @@ TEST(CholeskyPreconditioner, SingleAndDoublePrecisionFactorsAgree) {
 // A matrix positive definite in double precision but not in single (a free plate, singular up to
 // a shift of 1e-10 of its largest diagonal entry): the factorisation falls back to CHOLMOD.
 TEST(CholeskyPreconditioner, FallsBackToDoublePrecisionForAnIllConditionedMatrix) {
-  StaticProblem p = square_plate(12, /*clamped=*/true, Quadrature::one_point);
+  Problem p = square_plate(12, /*clamped=*/true, Quadrature::one_point);
   p.boundary.clear();
   const ShellModel model(p.mesh, p.material, p.boundary, p.quadrature);
   Eigen::SparseMatrix<double> a = model.stiffness();

@@ -19,7 +19,7 @@ const PlateCase& kClampedPoint = kAnalyticPlates[3];
 
 // Relative error of the centre deflection (limit surface at the centre vertex).
 double centre_error(const PlateCase& c, int divisions, Quadrature rule, StaticResult* out = nullptr) {
-  StaticProblem p = testing::square_plate(divisions, c.clamped, rule);
+  Problem p = testing::square_plate(divisions, c.clamped, rule);
   const int centre = testing::nearest_vertex(p.mesh, Eigen::Vector3d::Zero());
   if (!c.point_load)
     p.surface_load = Eigen::Vector3d(0, 0, -1.0);
@@ -73,7 +73,7 @@ TEST(AnalyticPlates, CantileverTipUnderEndLoad) {
   // Strip L × b, ν = 0 (plate bending = beam bending), clamped at x = −L/2, tip force P shared
   // by the tip-row vertices with trapezoidal weights.
   const double length = 1.0, width = 0.1, thickness = 0.01, youngs = 1e7, force = 1e-3;
-  StaticProblem p;
+  Problem p;
   p.mesh = make_grid(length, width, 40, 4);
   p.material = ShellMaterial::from_solid(youngs, 0.0, thickness, 1000);
   BoundaryCondition clamp;
@@ -98,7 +98,7 @@ TEST(AnalyticPlates, CantileverTipUnderEndLoad) {
 
 TEST(AnalyticPlates, SolveIsBitwiseDeterministic) {
   // Colour-parallel assembly and the threaded factorisation must give the same bits each time.
-  StaticProblem p = testing::square_plate(48, true, Quadrature::three_point);
+  Problem p = testing::square_plate(48, true, Quadrature::three_point);
   p.surface_load = Eigen::Vector3d(0.1, -0.2, -1.0);
   const StaticResult a = solve_static(p), b = solve_static(p);
   EXPECT_TRUE((a.displacement.array() == b.displacement.array()).all());
@@ -106,7 +106,7 @@ TEST(AnalyticPlates, SolveIsBitwiseDeterministic) {
 }
 
 TEST(AnalyticPlates, UnsupportedStructureIsReported) {
-  StaticProblem p = testing::square_plate(4, false, Quadrature::one_point);
+  Problem p = testing::square_plate(4, false, Quadrature::one_point);
   p.boundary.clear();
   p.surface_load = Eigen::Vector3d(0, 0, -1);
   try {

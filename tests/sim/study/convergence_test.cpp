@@ -25,7 +25,7 @@ namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
 
-std::vector<SurfacePoint> cylinder_points(const TriMesh& mesh, int n_theta, int n_s) {
+std::vector<SurfaceSample> cylinder_points(const TriMesh& mesh, int n_theta, int n_s) {
   return locate_points(mesh.triangles, cylinder_chart(mesh.vertices), cylinder_parameter_grid(n_theta, n_s), kTwoPi);
 }
 
@@ -33,7 +33,7 @@ TEST(SurfaceSampling, LocatedPointsReproduceTheirChartCoordinates) {
   const TriMesh mesh = make_cylinder(0.05, 0.2, 13, 10);
   const Eigen::MatrixX2d chart = cylinder_chart(mesh.vertices);
   const Eigen::MatrixX2d targets = cylinder_parameter_grid(32, 16);
-  const std::vector<SurfacePoint> points = locate_points(mesh.triangles, chart, targets, kTwoPi);
+  const std::vector<SurfaceSample> points = locate_points(mesh.triangles, chart, targets, kTwoPi);
   ASSERT_EQ(points.size(), 32u * 16u);
   int seam = 0;
   for (size_t p = 0; p < points.size(); ++p) {
@@ -69,7 +69,7 @@ TEST(SurfaceSampling, PointOutsideTheMeshIsAnError) {
 TEST(SurfaceSampling, RigidMotionGivesItsOwnDisplacement) {
   const TriMesh mesh = make_cylinder(0.05, 0.2, 13, 10);
   const ExtendedMesh ext = build_ghost_layer(mesh);
-  const std::vector<SurfacePoint> points = cylinder_points(mesh, 32, 16);
+  const std::vector<SurfaceSample> points = cylinder_points(mesh, 32, 16);
   const Eigen::SparseMatrix<double, Eigen::RowMajor> w = limit_sampling_matrix(ext, points);
   ASSERT_EQ(w.rows(), 32 * 16);
   ASSERT_EQ(w.cols(), ext.num_vertices());
@@ -95,10 +95,10 @@ TEST(SurfaceSampling, RigidMotionGivesItsOwnDisplacement) {
 // At a control vertex the sampling operator gives the vertex's limit point: the plate centre
 // sampled through the chart equals solve_static's limit displacement there.
 TEST(SurfaceSampling, PlateCentreMatchesTheLimitDisplacementOfTheCentreVertex) {
-  const StaticProblem problem = plate_problem(kAnalyticPlates[0], 8, Quadrature::one_point);
+  const Problem problem = plate_problem(kAnalyticPlates[0], 8, Quadrature::one_point);
   const StaticResult result = solve_static(problem);
   const Eigen::MatrixX2d chart = problem.mesh.vertices.leftCols<2>();
-  const std::vector<SurfacePoint> centre = locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
+  const std::vector<SurfaceSample> centre = locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
   const Eigen::MatrixX3d u =
       limit_sampling_matrix(build_ghost_layer(problem.mesh), centre) * result.extended_displacement;
   const int vertex = nearest_vertex(problem.mesh, Eigen::Vector3d::Zero());
@@ -220,7 +220,7 @@ TEST(ConvergenceStudy, ExtraMethodsBecomeExtraRows) {
 
   Method exact;
   exact.name = "analytic_times_1.01";
-  exact.solve_static = [](const StaticProblem& problem, const std::vector<SurfacePoint>& points) {
+  exact.solve_static = [](const Problem& problem, const std::vector<SurfaceSample>& points) {
     MethodRun run;
     run.vertices = problem.mesh.num_vertices();
     run.displacements = {Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(points.size()), 3)};
@@ -236,7 +236,7 @@ TEST(ConvergenceStudy, ExtraMethodsBecomeExtraRows) {
 TEST(ConvergenceStudy, FailedRunsAreRecordedNotFatal) {
   Method broken;
   broken.name = "broken";
-  broken.solve_static = [](const StaticProblem&, const std::vector<SurfacePoint>&) -> MethodRun {
+  broken.solve_static = [](const Problem&, const std::vector<SurfaceSample>&) -> MethodRun {
     throw std::runtime_error("singular, on purpose");
   };
   const std::vector<ConvergenceRow> rows = run_convergence(plate_plan({4}), {broken}, {});

@@ -63,7 +63,7 @@ TEST(StabilityCases, TheMatrixSpansTheRequestedRanges) {
   std::set<double> thickness;
   for (const StabilityCase& c : cases) {
     const Scene scene = load(c);
-    const DynamicProblem& p = scene.dynamic;
+    const Problem& p = scene.problem;
     et_min = std::min(et_min, p.material.stretch_modulus);
     et_max = std::max(et_max, p.material.stretch_modulus);
     nu_min = std::min(nu_min, p.material.poisson_ratio);
@@ -87,7 +87,7 @@ TEST(StabilityCases, TheMatrixSpansTheRequestedRanges) {
   }
   EXPECT_NEAR(et_min, 1000.0, 1e-9);  // the 0.1 mm sheet; cotton's 5000 N/m is the base
   EXPECT_TRUE(std::any_of(cases.begin(), cases.end(), [](const StabilityCase& c) {
-    return load(c).dynamic.material.stretch_modulus == 5000.0;
+    return load(c).problem.material.stretch_modulus == 5000.0;
   }));
   EXPECT_EQ(et_max, 1e7);
   EXPECT_EQ(nu_min, 0.0);

@@ -1,7 +1,7 @@
 // Boundary conditions on control vertices (paper §4.4, formulas.md §6).
 #pragma once
 
-#include "sim/shell/motion.hpp"
+#include "sim/boundary/motion.hpp"
 
 #include <array>
 #include <vector>

@@ -51,6 +51,8 @@ class CorotationalElements {
   // The same into `k`, reusing its storage: `k` is empty or was filled by an earlier call (only
   // its values are rewritten when its pattern matches the model's).
   void assemble_stiffness(Eigen::SparseMatrix<double>& k) const;
+  // k += scale · Σ R K_e Rᵀ (with the tension stiffening when on); `k` has the model's pattern.
+  void add_stiffness(double scale, Eigen::SparseMatrix<double>& k) const;
   // Energy and force of one element for a given rotation (patch coordinates): for tests.
   double element_energy(int e, const Eigen::Matrix3d& r, const Eigen::VectorXd& x_patch) const;
   Eigen::VectorXd element_force(int e, const Eigen::Matrix3d& r, const Eigen::VectorXd& x_patch) const;
@@ -66,6 +68,7 @@ class CorotationalElements {
   void set_geometric_stiffness(bool on) { tension_stiffening_ = on; }
 
   double last_rotate_ms() const { return rotate_ms_; }
+  double total_rotate_ms() const { return total_rotate_ms_; }  // over every evaluate() so far
   double last_force_ms() const { return force_ms_; }
 
  private:
@@ -73,6 +76,9 @@ class CorotationalElements {
   // + Bᵀ D_b H B) applied factor by factor (a third of the work of the dense product). With
   // `tension` (3 per quadrature point), also the point's tension stiffening (see tension_).
   void stiffness_product(size_t e, const double* d, double* kd, double* tension = nullptr) const;
+  // values += scale · (gathered blocks + folded elements), or = with `overwrite` (the gather
+  // covers the whole pattern).
+  void accumulate_stiffness(double scale, bool overwrite, double* values) const;
   // Lays out the gather from the elements' packed upper blocks (emptied) and fold weights W.
   void build_assembly(std::vector<std::vector<double>>& packed, const std::vector<Eigen::MatrixXd>& fold_weights);
 
@@ -128,9 +134,10 @@ class CorotationalElements {
   std::vector<int> scatter_start_, scatter_source_;
   std::vector<double> scatter_weight_;
   std::vector<double> local_energy_;
+  mutable std::vector<double> scratch_;  // add_stiffness with folded elements: the unscaled values
   Eigen::VectorXd force_;
   double energy_ = 0.0;
-  double rotate_ms_ = 0.0, force_ms_ = 0.0;
+  double rotate_ms_ = 0.0, force_ms_ = 0.0, total_rotate_ms_ = 0.0;
 };
 
 }  // namespace clothsim

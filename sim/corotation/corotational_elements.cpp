@@ -1,6 +1,6 @@
-#include "sim/dynamics/corotation.hpp"
+#include "sim/corotation/corotational_elements.hpp"
 
-#include "sim/dynamics/assembly_kernels.hpp"
+#include "sim/corotation/assembly_kernels.hpp"
 
 #include "sim/shell/element.hpp"
 #include "sim/subdivision/box_spline.hpp"
@@ -388,6 +388,7 @@ void CorotationalElements::evaluate(const Eigen::VectorXd& u) {
     }
   });
   rotate_ms_ = ms_since(t0);
+  total_rotate_ms_ += rotate_ms_;
   const auto t1 = std::chrono::steady_clock::now();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 32), [&](const tbb::blocked_range<size_t>& range) {
     PatchVector d, kd;
@@ -429,11 +430,32 @@ void CorotationalElements::assemble_stiffness(Eigen::SparseMatrix<double>& k) co
   const Eigen::SparseMatrix<double>& pattern = model_.pattern();
   if (k.rows() != pattern.rows() || k.cols() != pattern.cols() || !k.isCompressed() || k.nonZeros() != pattern.nonZeros())
     k = pattern;
+  else
+    std::fill(k.valuePtr(), k.valuePtr() + k.nonZeros(), 0.0);
+  add_stiffness(1.0, k);
+}
+
+void CorotationalElements::add_stiffness(double scale, Eigen::SparseMatrix<double>& k) const {
+  if (folded_groups_.empty()) {  // the gather alone: each block summed once, added scaled
+    accumulate_stiffness(scale, /*overwrite=*/false, k.valuePtr());
+    return;
+  }
+  // With folded elements the blocks are completed (gather, then folded contributions) before
+  // they are scaled, in a scratch copy of the values: the same sums, in the same order, whatever
+  // the scale.
+  scratch_.resize(static_cast<size_t>(k.nonZeros()));
+  accumulate_stiffness(1.0, /*overwrite=*/true, scratch_.data());
   double* values = k.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, scratch_.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) values[i] += scale * scratch_[i];
+  });
+}
+
+void CorotationalElements::accumulate_stiffness(double scale, bool overwrite, double* values) const {
   const auto sum = assembly_avx2::supported() ? assembly_avx2::sum_block : assembly_avx2::sum_block_portable;
   const double* rotations = rotation_.empty() ? nullptr : rotation_.front().data();  // Matrix3d: 9 contiguous values each
   const double* tension = tension_stiffening_ ? tension_.data() : nullptr;
-  // Every value is written here (the gather covers the whole pattern).
+  // The gather covers the whole pattern: each block is summed once and added, scaled, once.
   tbb::parallel_for(tbb::blocked_range<size_t>(0, block_upper_.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t u = range.begin(); u != range.end(); ++u) {
       double acc[9];
@@ -446,9 +468,14 @@ void CorotationalElements::assemble_stiffness(Eigen::SparseMatrix<double>& k) co
       const int su = block_stride_upper_[u], sl = block_stride_lower_[u];
       for (int j = 0; j < 3; ++j)
         for (int i = 0; i < 3; ++i) {
-          const double value = acc[i + 3 * j];
-          upper[j * su + i] = value;
-          if (lower != upper) lower[i * sl + j] = value;  // a diagonal block is written once, as summed
+          const double value = scale * acc[i + 3 * j];
+          if (overwrite) {
+            upper[j * su + i] = value;
+            if (lower != upper) lower[i * sl + j] = value;  // a diagonal block is written once, as summed
+          } else {
+            upper[j * su + i] += value;
+            if (lower != upper) lower[i * sl + j] += value;
+          }
         }
     }
   });
@@ -488,7 +515,7 @@ void CorotationalElements::assemble_stiffness(Eigen::SparseMatrix<double>& k) co
           for (Eigen::SparseMatrix<double>::InnerIterator it(fold, row); it; ++it) folded.row(row) += it.value() * half.row(it.row());
         for (size_t b = 0; b < el.real.size(); ++b)
           for (size_t a = 0; a < el.real.size(); ++a)
-            model_.add_block(e, a, b, folded.block<3, 3>(3 * static_cast<Eigen::Index>(a), 3 * static_cast<Eigen::Index>(b)), values);
+            model_.add_block(e, a, b, scale * folded.block<3, 3>(3 * static_cast<Eigen::Index>(a), 3 * static_cast<Eigen::Index>(b)), values);
       }
     });
 }

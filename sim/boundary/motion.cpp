@@ -1,4 +1,4 @@
-#include "sim/shell/motion.hpp"
+#include "sim/boundary/motion.hpp"
 
 #include <Eigen/Geometry>
 

@@ -1,5 +1,5 @@
 // Compiled with -mavx2 -mfma (sim/CMakeLists.txt); called only when supported() says so.
-#include "sim/dynamics/assembly_kernels.hpp"
+#include "sim/corotation/assembly_kernels.hpp"
 
 #include <immintrin.h>
 

@@ -1,7 +1,7 @@
-// The corotational stiffness gather's block sums (sim/dynamics/assembly_kernels.hpp): the AVX2
+// The corotational stiffness gather's block sums (sim/corotation/assembly_kernels.hpp): the AVX2
 // kernel and the portable one against a plain Eigen reference, Σ R K Rᵀ (+ the tension term on
 // the diagonal), on random rotations, blocks and tensions.
-#include "sim/dynamics/assembly_kernels.hpp"
+#include "sim/corotation/assembly_kernels.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

@@ -1,0 +1,143 @@
+#include "sim/discretization/loop_shell.hpp"
+
+#include "sim/core/layout.hpp"
+#include "sim/forces/corotated_shell.hpp"
+#include "sim/shell/ghost_layer.hpp"
+#include "sim/subdivision/limit_refinement.hpp"
+#include "sim/subdivision/loop.hpp"
+#include "sim/subdivision/patch.hpp"
+
+#include <Eigen/Geometry>
+
+#include <stdexcept>
+#include <string>
+
+namespace clothsim {
+
+TriMesh LoopShellDiscretization::prepare_mesh(const TriMesh& mesh, const LogFn& log) {
+  check_triangles(mesh);
+  auto count_bad = [](const TriMesh& m) {
+    const ExtendedMesh ext = build_ghost_layer(m);
+    int bad = 0;
+    for (const Triangle& t : m.triangles)
+      if (irregular_vertex_count(ext, t) > 1) ++bad;
+    return bad;
+  };
+  const int bad = count_bad(mesh);
+  if (bad == 0) return mesh;
+  TriMesh refined = loop_subdivide(mesh);
+  if (log)
+    log("mesh: " + std::to_string(bad) + " triangle(s) have more than one irregular vertex; refined once by Loop "
+        "subdivision: " + std::to_string(mesh.num_vertices()) + " -> " + std::to_string(refined.num_vertices()) +
+        " vertices, " + std::to_string(mesh.num_triangles()) + " -> " + std::to_string(refined.num_triangles()) +
+        " triangles");
+  if (const int still = count_bad(refined); still > 0)
+    throw MeshError(std::to_string(still) + " triangle(s) still have more than one irregular vertex after refinement");
+  return refined;
+}
+
+LoopShellDiscretization::LoopShellDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary,
+                                                 const ShellMaterial& material, Quadrature quadrature)
+    : mesh_(mesh), model_(mesh, material, boundary, quadrature), rest_(to_flat(mesh.vertices)) {
+  for (int dof = 0; dof < 3 * mesh.num_vertices(); ++dof)
+    if (status(dof) == DofStatus::dependent) dependent_.push_back(dof);
+}
+
+void LoopShellDiscretization::make_consistent(Eigen::VectorXd& u) const {
+  for (int dof : dependent_) {
+    double value = 0.0;
+    for (const auto& [d, w] : model_.dofs().combination(dof / 3, dof % 3)) value += w * u(d);
+    u(dof) = value;
+  }
+}
+
+Eigen::VectorXd LoopShellDiscretization::lumped_mass(double areal_density) const {
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh_.num_vertices());
+  for (const Triangle& t : mesh_.triangles) {
+    const Eigen::Vector3d x0 = mesh_.vertices.row(t[0]), x1 = mesh_.vertices.row(t[1]), x2 = mesh_.vertices.row(t[2]);
+    const double area = 0.5 * (x1 - x0).cross(x2 - x0).norm();
+    for (int v : t) mass(v) += areal_density * area / 3.0;
+  }
+  return mass;
+}
+
+Eigen::VectorXd LoopShellDiscretization::traction_load(
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d& normal)>& traction) const {
+  return model_.surface_traction_load([&](const SurfacePoint& s) { return traction(s.a3); });
+}
+
+std::unique_ptr<ForceTerm> LoopShellDiscretization::elastic_term(bool corotational, bool tension_stiffening) const {
+  return std::make_unique<CorotatedShell>(model_, corotational, tension_stiffening);
+}
+
+Eigen::MatrixX3d LoopShellDiscretization::control_net(const Eigen::VectorXd& x) const {
+  Eigen::VectorXd u = x - rest_;
+  make_consistent(u);
+  return model_.extended().rest + model_.dofs().expand(as_rows(u));
+}
+
+SurfaceOperator LoopShellDiscretization::node_points(const std::vector<int>& nodes) const {
+  // The limit position mask over each vertex's (closed, extended) one-ring.
+  const ExtendedMesh& ext = model_.extended();
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const int v = nodes[i], row = static_cast<int>(i);
+    if (v < 0 || v >= ext.num_real)
+      throw std::out_of_range("node_points: node " + std::to_string(v) + " is not a vertex of the mesh (" +
+                              std::to_string(ext.num_real) + " vertices)");
+    const std::vector<int>& ring = ext.topology.ring(v);
+    const int valence = static_cast<int>(ring.size());
+    const double w = limit_neighbour_weight(valence);
+    entries.emplace_back(row, v, 1.0 - valence * w);
+    for (int r : ring) entries.emplace_back(row, r, w);
+  }
+  SurfaceOperator op;
+  op.position.resize(static_cast<Eigen::Index>(nodes.size()), ext.num_vertices());
+  op.position.setFromTriplets(entries.begin(), entries.end());
+  return op;
+}
+
+SurfaceOperator LoopShellDiscretization::samples(const std::vector<SurfaceSample>& points) const {
+  // Row p: the subdivision basis (value row) of the point's patch at (v, w).
+  const ExtendedMesh& ext = model_.extended();
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t p = 0; p < points.size(); ++p) {
+    const SurfaceSample& sp = points[p];
+    if (sp.triangle < 0 || sp.triangle >= ext.num_real_triangles)
+      throw std::invalid_argument("surface samples: point " + std::to_string(p) + " names triangle " +
+                                  std::to_string(sp.triangle) + ", not a triangle of the mesh");
+    const PatchEvaluation pe = evaluate_patch(ext.topology, ext.triangles[static_cast<size_t>(sp.triangle)], sp.v, sp.w);
+    for (size_t k = 0; k < pe.vertices.size(); ++k)
+      if (pe.basis(0, static_cast<Eigen::Index>(k)) != 0.0)
+        entries.emplace_back(static_cast<int>(p), pe.vertices[k], pe.basis(0, static_cast<Eigen::Index>(k)));
+  }
+  SurfaceOperator op;
+  op.position.resize(static_cast<Eigen::Index>(points.size()), ext.num_vertices());
+  op.position.setFromTriplets(entries.begin(), entries.end());
+  return op;
+}
+
+SurfaceOperator LoopShellDiscretization::display(int levels) const {
+  const ExtendedMesh& ext = model_.extended();
+  LimitRefinement r = build_limit_refinement(ext.rest, ext.triangles, ext.num_real_triangles, levels);
+  SurfaceOperator op;
+  op.position = std::move(r.position);
+  op.tangent1 = std::move(r.tangent1);
+  op.tangent2 = std::move(r.tangent2);
+  op.triangles = std::move(r.triangles);
+  op.levels = r.levels;
+  return op;
+}
+
+void LoopShellDiscretization::add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces,
+                                               Eigen::VectorXd& f) const {
+  // Jᵀ F: each point's force spread over its control points with the operator's weights, then
+  // from each control point (a ghost: a combination of nodes) onto the nodes' components.
+  for (Eigen::Index p = 0; p < op.position.rows(); ++p)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(op.position, p); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        for (const auto& [dof, w] : model_.dofs().combination(static_cast<int>(it.col()), c))
+          f(dof) += it.value() * w * forces(p, c);
+}
+
+}  // namespace clothsim

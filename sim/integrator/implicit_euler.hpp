@@ -1,0 +1,164 @@
+// Implicit Euler with the velocities as unknowns (paper §4.2 eq. 28 as a first-order system),
+// over any discretisation and any set of force terms (sim/forces/force_term.hpp).
+//
+// Each step solves the linearised
+//     (M + h D + h² K) v⁺ = M v + h f₀(x),     x⁺ = x + h v⁺,
+// with f = f₀ − D v the terms' force, K = −∂f₀/∂x and D their stiffness and damping at the
+// linearisation point x (for the corotated shell: the rotations extracted at x and frozen, so
+// K = Σ R K_e Rᵀ). The weights (1, h, h²) belong to this integrator and nowhere else. Further
+// Newton iterations (newton_iterations > 1) re-evaluate the terms at x + h v_k and solve
+//     (M + h D + h² K) v⁺ = M v + h f₀(x + h v_k) + h² K v_k.
+// Measured trade-offs: with one solve the rotations lag the motion by a step, so a body that
+// rotates fast gains a little strain energy per step (a strip flapping at 5 rad/s, h = 2 ms: up
+// to 1.8e-4 of its energy; a sleeve spinning at 10 rad/s, h = 1 ms: 2.2e-5 of its size); two or
+// three iterations remove both. Starting the iteration from the predicted state x + h v instead
+// was tried and rejected: it sets twisted sleeves into a step-to-step oscillation that never
+// decays (kinetic energy 8e-3 J against 4e-10 J from x).
+//
+// Constraints: fixed DOFs get the velocity that puts them exactly on their scripted motion at
+// t + h (ScriptedBoundary); dependent DOFs follow the discretisation's rule
+// (Discretization::make_consistent); only free DOFs are unknowns of the linear solve.
+// Writes no files.
+#pragma once
+
+#include "sim/boundary/scripted_boundary.hpp"
+#include "sim/discretization/discretization.hpp"
+#include "sim/forces/force_term.hpp"
+#include "sim/solver/linear_solver.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+// The state of a dynamic run, flat over the nodes (sim/core/layout.hpp).
+struct DynamicState {
+  Eigen::VectorXd x;  // positions, 3·#nodes [m]
+  Eigen::VectorXd v;  // velocities, 3·#nodes [m/s]
+  double t = 0.0;     // [s]
+  int step = 0;       // steps taken
+  // #nodes × 3 views.
+  Eigen::Map<const RowMatrixX3d> positions() const { return as_rows(x); }
+  Eigen::Map<const RowMatrixX3d> velocities() const { return as_rows(v); }
+};
+
+struct IntegratorSettings {
+  double dt = 1e-3;           // time step [s]
+  int newton_iterations = 1;  // linear solves per step; > 1 re-evaluates the terms (accuracy studies)
+  // The iterative solver's start: the last velocity extrapolated by its last change,
+  // v + (v − v_prev) (constant acceleration), or the last velocity itself.
+  bool extrapolated_start = true;
+};
+
+// Per-step figures (one row of stats.csv).
+struct StepStats {
+  int step = 0;
+  double t = 0.0;                // time at the end of the step [s]
+  int solver_iterations = 0;     // pcg iterations summed over Newton iterations (1 per direct solve)
+  double residual = 0.0;         // final relative residual of the linear system
+  double newton_change = 0.0;    // ‖v⁺_k − v⁺_{k−1}‖ / ‖v⁺_k‖ of the last Newton iteration (0 with one)
+  double rotate_ms = 0.0;        // rotation extraction (filled by the Simulator)
+  double update_ms = 0.0;        // evaluating the force terms (rotations included)
+  double assemble_ms = 0.0;      // system matrix and right-hand side (with the Simulator: element
+                                 // forces too, as before the split)
+  double solve_ms = 0.0;         // linear solve (with any factorisation)
+  int factorizations = 0;        // Cholesky factorisations in this step (direct solve or preconditioner)
+  double factor_ms = 0.0;        // their time, part of solve_ms
+  double kinetic_energy = 0.0;   // ½ vᵀ M v [J]
+  double elastic_energy = 0.0;   // energy of the internal terms [J]
+  double external_work = 0.0;    // work of the external loads on the free components this step [J]
+  double boundary_work = 0.0;    // work of the scripted and held components on the cloth this step
+                                 // [J] (ImplicitEuler::boundary_work)
+};
+
+// A run that cannot go on: NaN, divergence or a linear solver that does not converge.
+class SimulationError : public std::runtime_error {
+ public:
+  enum class Kind {
+    other,     // anything else (e.g. a follower couple that lost its lever arm)
+    nan,       // the state became NaN or infinite
+    diverged,  // a vertex moved more than 1000 times the mesh size
+    solver,    // the linear solver did not converge or the matrix was not positive definite
+  };
+  SimulationError(int step, double t, const std::string& what, Kind kind = Kind::other)
+      : std::runtime_error("step " + std::to_string(step) + " (t = " + std::to_string(t) + " s): " + what),
+        step_(step),
+        t_(t),
+        kind_(kind) {}
+  int step() const { return step_; }
+  double time() const { return t_; }
+  Kind kind() const { return kind_; }
+
+ private:
+  int step_;
+  double t_;
+  Kind kind_;
+};
+
+class ImplicitEuler {
+ public:
+  // `internal`: the cloth's own terms (elastic, damping), whose energies make elastic_energy();
+  // `loads`: the external loads (may be null), whose work makes external_work(). All of them,
+  // the discretisation, the boundary and the solver must outlive the integrator. `node_mass`: the
+  // lumped mass per node [kg]. The terms are evaluated at `state` (its x consistent).
+  ImplicitEuler(const IntegratorSettings& settings, const Discretization& discretization, const Eigen::VectorXd& node_mass,
+                std::vector<ForceTerm*> internal, ForceTerm* loads, const ScriptedBoundary& boundary, LinearSolver& solver,
+                const DynamicState& state);
+
+  // Advances `state` by one step. Throws SimulationError (naming the step and time) on NaN,
+  // divergence, a term that cannot be evaluated or a linear solver that does not converge;
+  // `state` is then left as it was.
+  StepStats step(DynamicState& state);
+
+  // ½ vᵀ M v [J].
+  double kinetic_energy(const DynamicState& state) const;
+  // Σ energy of the internal terms at the last evaluated state [J].
+  double elastic_energy() const;
+  // Energy bookkeeping [J]: the work done so far by the external loads on the free components,
+  // Σ f_extᵀ (x⁺ − x); and the work done so far on the cloth by the scripted and held
+  // components. Over a run, with E = kinetic + elastic energy,
+  //     E(t) − E(0) = external_work + boundary_work − dissipated,
+  // where `dissipated` >= 0 for a linear (non-rotating) system: Kelvin–Voigt and mass damping,
+  // and implicit Euler's own ½|Δv|²_M + ½ Δxᵀ K Δx per step. A rise beyond the two works comes
+  // from the nonlinearity of the corotation (rotations frozen over a step) or a bug.
+  //
+  // Boundary work. A prescribed component p is moved by Δx_p = h v⁺_p; the force the support
+  // exerts on it is the reaction that makes its row of the step's system hold,
+  //     h R_p = (A v⁺ − b)_p,   A = M + h D + h² K,  b = M v + h f₀,
+  // i.e. R_p = M (v⁺ − v)/h − [f₀ − h K v⁺ − D v⁺]_p: inertia minus the cloth's (linearised
+  // end-of-step, damped) force on that component. The work of the support and of the load on the
+  // component, (R_p + f_ext,p) Δx_p, is summed. Using the integrator's own force (not a
+  // quadrature of f over the step) makes the balance above exact, step by step, for a linear
+  // system: a rise then measures the corotation's error alone.
+  double external_work() const { return work_; }
+  double boundary_work() const { return boundary_work_; }
+  // Displacement from the rest state (3·#nodes) [m] of the last state reached, consistent.
+  const Eigen::VectorXd& displacement() const { return u_; }
+
+ private:
+  void update_terms(const Eigen::VectorXd& x, const Eigen::VectorXd& u, double t);
+
+  IntegratorSettings settings_;
+  const Discretization& discretization_;
+  std::vector<ForceTerm*> internal_;
+  ForceTerm* loads_;
+  std::vector<ForceTerm*> all_;  // internal, then loads
+  const ScriptedBoundary& boundary_;
+  LinearSolver& solver_;
+  Eigen::VectorXd mass_;            // 3·#nodes [kg]
+  std::vector<char> free_;          // 3·#nodes: unknown in the linear solve
+  std::vector<int> dependent_;      // dependent DOFs
+  Eigen::VectorXd u_;               // displacement of the current state
+  Eigen::VectorXd v_previous_;      // velocity at the start of the previous step (extrapolated start)
+  Eigen::SparseMatrix<double> system_;    // the step's matrix, its storage reused from step to step
+  Eigen::SparseMatrix<double> stiffness_;  // K alone (Newton iterations only)
+  std::vector<Eigen::Index> diagonal_;    // value offsets of its diagonal entries
+  double size_ = 1.0;                     // bounding-box diagonal of the rest state [m]
+  double work_ = 0.0, boundary_work_ = 0.0;
+};
+
+}  // namespace clothsim

@@ -1,0 +1,75 @@
+// One problem: what a scene file describes, for a static or a dynamic analysis alike — the mesh,
+// the material, the boundary conditions, the loads, the numerics and (read by a dynamic analysis
+// only) time, damping, solver settings and the initial state. Built by the scene loader
+// (sim/scene/), checked by sim/problem/validate.hpp, solved by sim/static/ (linear statics, paper
+// eq. 25) or sim/dynamics/ (implicit Euler, paper eq. 28).
+#pragma once
+
+#include "sim/mesh/mesh.hpp"
+#include "sim/boundary/boundary_condition.hpp"
+#include "sim/shell/material.hpp"
+#include "sim/shell/quadrature.hpp"
+#include "sim/forces/follower_couples.hpp"
+#include "sim/forces/point_loads.hpp"
+#include "sim/integrator/implicit_euler.hpp"
+#include "sim/solver/linear_solver.hpp"
+
+#include <Eigen/Core>
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+struct TimeSettings {
+  double dt = 1e-3;          // time step [s]
+  double end = 1.0;          // simulated duration [s]
+  double output_fps = 30.0;  // frames written per simulated second [1/s]
+};
+
+// Kelvin–Voigt damping proportional to the (rotated) stiffness, plus mass damping:
+// D = stiffness · K_R + mass · M.
+struct DampingSettings {
+  double stiffness = 0.0;  // [s]
+  double mass = 0.0;       // [1/s]
+};
+
+// The "solver" settings of a scene: the linear solver's own (sim/solver/linear_solver.hpp) and
+// the integrator's and elastic term's numerical options.
+struct SolverSettings : LinearSolverSettings {
+  int newton_iterations = 1;  // linear solves per step; > 1 re-extracts rotations (accuracy studies)
+  bool tension_stiffening = true;  // membrane geometric stiffness in the matrix (corotational_elements.hpp)
+  // pcg's start: the last velocity extrapolated by its last change, v + (v − v_prev)
+  // (constant acceleration), or the last velocity itself.
+  bool extrapolated_start = true;
+};
+
+// Rigid initial velocity field v = velocity + angular_velocity × (X − center).
+struct InitialState {
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();          // [m/s]
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  // [rad/s]
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();            // [m]
+};
+
+struct Problem {
+  TriMesh mesh;  // control mesh, prepared by the discretisation (LoopShellDiscretization::prepare_mesh)
+  ShellMaterial material;
+  std::vector<BoundaryCondition> boundary;  // dynamic: fixed components follow BoundaryCondition::motion
+  // Gravity [m/s²]: lumped in a dynamic analysis, consistent in a static one (sim/forces/gravity.hpp).
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d surface_load = Eigen::Vector3d::Zero();  // [N/m² of reference area]
+  double pressure = 0.0;                                   // [N/m²] along the reference normal
+  std::vector<PointLoad> point_loads;                      // [N], constant
+  std::vector<MomentLoad> moments;                         // [N·m], follower couples (static: at rest)
+  Quadrature quadrature = Quadrature::one_point;
+  // Dynamic analysis only:
+  double ramp_time = 0.0;  // [s] external loads grow linearly from 0 to full over this time
+  TimeSettings time;
+  DampingSettings damping;
+  SolverSettings solver;
+  bool corotational = true;  // false: plain linear element (for comparison)
+  InitialState initial;
+};
+
+}  // namespace clothsim

@@ -1,0 +1,77 @@
+#include "sim/problem/validate.hpp"
+
+#include "sim/core/layout.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <stdexcept>
+
+namespace clothsim {
+
+namespace {
+
+// A double as a JSON number in its shortest round-trip form ("0.0", "1e-05").
+std::string format_number(double v) {
+  char buffer[64];
+  const auto end = std::to_chars(buffer, buffer + sizeof(buffer), v).ptr;
+  std::string s(buffer, end);
+  if (std::isfinite(v) && s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string index_key(const std::string& key, size_t i) { return key + "[" + std::to_string(i) + "]"; }
+
+}  // namespace
+
+std::optional<ProblemIssue> find_issue(const Problem& p, Analysis analysis) {
+  if (const std::string bad = validate(p.material); !bad.empty()) return ProblemIssue{"material", bad};
+  const int n = p.mesh.num_vertices();
+  const bool dynamic = analysis == Analysis::dynamics;
+  if (dynamic && !(p.material.areal_density > 0))
+    return ProblemIssue{"material", "a dynamic analysis needs a positive areal density (mass) [kg/m²] (got " +
+                                        format_number(p.material.areal_density) + ")"};
+  for (size_t i = 0; i < p.boundary.size(); ++i) {
+    const BoundaryCondition& bc = p.boundary[i];
+    const std::string key = index_key("boundary", i);
+    for (int v : bc.vertices)
+      if (v < 0 || v >= n) return ProblemIssue{key, "vertex " + std::to_string(v) + " is not a vertex of the mesh"};
+    if (!bc.motion.empty() && !dynamic) return ProblemIssue{key + ".motion", "needs \"analysis\": \"dynamic\" (this scene is static)"};
+    if (!bc.motion.empty() && bc.clamped)
+      return ProblemIssue{key + ".rotation", "\"clamped\" cannot be combined with a motion yet (the clamped border rule is "
+                                             "linear in the displacement); use \"free\" (hinged)"};
+    for (size_t k = 0; k < bc.motion.size(); ++k)
+      if (const std::string bad = validate(bc.motion[k]); !bad.empty()) return ProblemIssue{index_key(key + ".motion", k), bad};
+  }
+  for (size_t i = 0; i < p.point_loads.size(); ++i) {
+    const int v = p.point_loads[i].vertex;
+    if (v < 0 || v >= n)
+      return ProblemIssue{index_key("loads.point_loads", i), "point load at vertex " + std::to_string(v) + ": no such vertex"};
+  }
+  const Eigen::VectorXd rest = to_flat(p.mesh.vertices);
+  for (size_t i = 0; i < p.moments.size(); ++i) {
+    const std::string key = index_key("loads.moments", i) + ".select";
+    for (int v : p.moments[i].vertices)
+      if (v < 0 || v >= n) return ProblemIssue{key, "vertex " + std::to_string(v) + " is not a vertex of the mesh"};
+    Eigen::VectorXd f = Eigen::VectorXd::Zero(rest.size());
+    if (!add_moment_forces(p.moments[i], rest, f))
+      return ProblemIssue{key, "the selected vertices lie on one line parallel to the moment; select at least two rows of "
+                               "vertices across it"};
+  }
+  if (!dynamic) return std::nullopt;
+  if (!(std::isfinite(p.time.dt) && p.time.dt > 0)) return ProblemIssue{"time.dt", "must be > 0 [s]"};
+  if (!(std::isfinite(p.time.end) && p.time.end > 0)) return ProblemIssue{"time.end", "must be > 0 [s]"};
+  if (!(p.damping.stiffness >= 0)) return ProblemIssue{"damping.stiffness", "must be >= 0 [s]"};
+  if (!(p.damping.mass >= 0)) return ProblemIssue{"damping.mass", "must be >= 0 [1/s]"};
+  if (!(p.ramp_time >= 0)) return ProblemIssue{"loads.ramp_time", "must be >= 0 [s]"};
+  if (!(p.solver.tolerance > 0 && p.solver.tolerance < 1)) return ProblemIssue{"solver.tolerance", "must be > 0 and < 1"};
+  if (p.solver.max_iterations < 1) return ProblemIssue{"solver.max_iterations", "must be an integer >= 1"};
+  if (p.solver.newton_iterations < 1) return ProblemIssue{"solver.newton_iterations", "must be an integer >= 1"};
+  if (p.solver.refresh_iterations < 1) return ProblemIssue{"solver.refresh_iterations", "must be an integer >= 1"};
+  return std::nullopt;
+}
+
+void check_problem(const Problem& problem, Analysis analysis) {
+  if (const auto issue = find_issue(problem, analysis)) throw std::runtime_error(issue->text());
+}
+
+}  // namespace clothsim

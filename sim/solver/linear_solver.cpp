@@ -1,0 +1,125 @@
+#include "sim/solver/linear_solver.hpp"
+
+#include "sim/solver/cholesky_preconditioner.hpp"
+#include "sim/solver/direct_solver.hpp"
+#include "sim/solver/pcg.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <sstream>
+
+namespace clothsim {
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+struct LinearSolver::Impl {
+  DirectSolver direct;             // type "cholmod"
+  CholeskyPreconditioner factor;   // "pcg" with the "cholesky" preconditioner
+  // When to refresh `factor` (counted in conjugate-gradient iterations, see solve()).
+  int solves_since_factor = 0;
+  double iterations_since_factor = 0.0;
+  bool refactor_next = false;
+  explicit Impl(bool supernodal) : direct(supernodal) {}
+};
+
+LinearSolver::LinearSolver(const LinearSolverSettings& settings, Eigen::Index size)
+    : settings_(settings), impl_(std::make_unique<Impl>(/*supernodal=*/size > 3000)) {}
+
+LinearSolver::~LinearSolver() = default;
+
+LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::VectorXd& b, const std::vector<char>& free,
+                                      Eigen::VectorXd& x) {
+  Impl& m = *impl_;
+  const LinearSolverSettings& s = settings_;
+  LinearSolveReport report;
+  auto refactor = [&] {
+    const auto f0 = std::chrono::steady_clock::now();
+    m.factor.factorize(a, &free);  // of the Dirichlet form
+    ++report.factorizations;
+    report.factor_ms += ms_since(f0);
+    m.solves_since_factor = 0;
+    m.iterations_since_factor = 0.0;
+  };
+
+  if (s.type == LinearSolverType::cholmod) {
+    // Dirichlet form: constrained columns moved to the right-hand side, unit diagonal in their
+    // rows and columns.
+    Eigen::VectorXd fixed_values = Eigen::VectorXd::Zero(x.size());
+    for (Eigen::Index i = 0; i < x.size(); ++i)
+      if (!free[i]) fixed_values(i) = x(i);
+    b -= a * fixed_values;
+    for (Eigen::Index i = 0; i < x.size(); ++i)
+      if (!free[i]) b(i) = fixed_values(i);
+    set_dirichlet_identity(a, free);
+    const auto f0 = std::chrono::steady_clock::now();
+    const bool factored = m.direct.refactorize(a);
+    ++report.factorizations;
+    report.factor_ms += ms_since(f0);
+    if (!factored) {
+      report.failure = "the system matrix is not positive definite (CHOLMOD)";
+      return report;
+    }
+    x = m.direct.solve(b);
+    report.iterations = 1;
+    report.residual = (a * x - b).norm() / std::max(b.norm(), 1e-300);
+    report.converged = true;
+    return report;
+  }
+
+  const bool cholesky = s.preconditioner == PreconditionerType::cholesky;
+  if (cholesky && (!m.factor.ready() || m.refactor_next)) {
+    m.refactor_next = false;
+    refactor();
+  }
+  const Preconditioner factor = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor.apply(r, z); };
+  const Eigen::VectorXd start = x;
+  PcgResult r = solve_pcg(a, b, free, x, s.tolerance, s.max_iterations, cholesky && m.factor.ready() ? factor : Preconditioner());
+  if (cholesky) {
+    // The factor is of an earlier matrix, and the iterations grow as the matrix drifts from it
+    // (about one more per step in the buckling sleeve). Refactor when this solve cost more than
+    // the average per solve since the last factorisation, the factorisation included (for a cost
+    // that grows steadily this minimises the long-run average), or when it exceeded
+    // refresh_iterations. The new factor is of the next step's matrix (taken at the start of that
+    // step), not of this one, which is solved already: a factor of the matrix being solved needs
+    // 3–4 iterations (half-precision solves), one a step old 5–6 in the sleeve's slow phases and
+    // 9–60 while it snaps into folds. The factorisation's cost in iterations is estimated from its
+    // flop count against the flops of one iteration (two triangular solves and a product with A),
+    // scaled by 0.17, fitted on the 2542-vertex sleeve (2 cores): first with single-precision
+    // solves (factorisation 22 ms ≙ 21 iterations of 1.05 ms), checked again with half-precision
+    // solves (21.5 ms, 0.75 ms per iteration). The optimum is flat: 0.12 / 0.17 / 0.25 / 0.35 /
+    // 0.5 model to 11.4 / 11.3 / 11.7 / 12.0 / 12.5 ms of solve per step (docs/performance.md).
+    // Decided on counts, never on timings: runs are repeatable.
+    ++m.solves_since_factor;
+    m.iterations_since_factor += r.iterations;
+    const double iteration_work = 4.0 * static_cast<double>(m.factor.factor_entries()) + 2.0 * static_cast<double>(a.nonZeros());
+    const double factor_cost = 0.17 * m.factor.factor_flops() / std::max(iteration_work, 1.0);
+    const bool pays = r.iterations * m.solves_since_factor > factor_cost + m.iterations_since_factor;
+    if (!r.converged) {  // refactor now and solve again from the same start
+      refactor();
+      if (m.factor.ready()) {
+        report.iterations += r.iterations;
+        x = start;
+        r = solve_pcg(a, b, free, x, s.tolerance, s.max_iterations, factor);
+      }
+    } else if (r.iterations > s.refresh_iterations || pays) {
+      m.refactor_next = true;
+    }
+  }
+  report.iterations += r.iterations;
+  report.residual = r.residual;
+  report.converged = r.converged;
+  if (!r.converged) {
+    std::ostringstream text;
+    text << "the conjugate gradient solver did not converge: relative residual " << r.residual << " after "
+         << r.iterations << " iterations (tolerance " << s.tolerance
+         << "); try a smaller time step, more iterations or \"solver\": {\"type\": \"cholmod\"}";
+    report.failure = text.str();
+  }
+  return report;
+}
+
+}  // namespace clothsim

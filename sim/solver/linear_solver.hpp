@@ -1,0 +1,62 @@
+// The linear solver of the implicit step: one object that owns the choice of method (conjugate
+// gradients or a direct Cholesky factorisation), the preconditioner and the rule for refreshing
+// it. The integrator hands it the assembled system and the mask of unknowns; nothing about the
+// factorisations (CHOLMOD, the single/half-precision supernodal preconditioner, their BLAS and
+// vector kernels) leaks through this header.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+enum class LinearSolverType { pcg, cholmod };
+enum class PreconditionerType {
+  block_jacobi,  // inverse 3 × 3 diagonal blocks
+  cholesky,      // a Cholesky factor of an earlier step's matrix, refreshed when PCG slows down
+};
+
+struct LinearSolverSettings {
+  LinearSolverType type = LinearSolverType::pcg;
+  double tolerance = 1e-8;    // relative residual of the linear system (pcg)
+  int max_iterations = 2000;  // pcg
+  PreconditionerType preconditioner = PreconditionerType::block_jacobi;  // pcg
+  int refresh_iterations = 50;  // cholesky preconditioner: refactor after a solve that needed more
+};
+
+struct LinearSolveReport {
+  bool converged = false;
+  int iterations = 0;       // pcg iterations, a failed first attempt included (1 per direct solve)
+  double residual = 0.0;    // final relative residual
+  int factorizations = 0;   // Cholesky factorisations in this solve (direct, or the preconditioner's)
+  double factor_ms = 0.0;   // their time [ms]
+  std::string failure;      // why it did not converge (a sentence with advice), when !converged
+};
+
+class LinearSolver {
+ public:
+  // `size`: rows of the systems to come.
+  LinearSolver(const LinearSolverSettings& settings, Eigen::Index size);
+  ~LinearSolver();
+  LinearSolver(const LinearSolver&) = delete;
+  LinearSolver& operator=(const LinearSolver&) = delete;
+
+  // Solves A x = b on the entries with free[i] != 0 (A symmetric positive definite there, full
+  // storage, the pattern of every call the same); x holds the start (pcg) and, at the other
+  // entries, their fixed values. A and b may be overwritten (the direct solver's Dirichlet form).
+  LinearSolveReport solve(Eigen::SparseMatrix<double>& a, Eigen::VectorXd& b, const std::vector<char>& free,
+                          Eigen::VectorXd& x);
+
+  const LinearSolverSettings& settings() const { return settings_; }
+
+ private:
+  struct Impl;
+  LinearSolverSettings settings_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clothsim
