@@ -102,8 +102,8 @@ CantileverResult load_cantilever(double alpha, int along, int across) {
   Simulator sim(p);
   for (int i = 0; i < sim.num_steps(); ++i) sim.step();
 
-  const Eigen::MatrixX3d x = sim.limit_positions();
-  const Eigen::MatrixX3d& rest = sim.limit_rest();
+  const Eigen::MatrixX3d x = sim.node_points();
+  const Eigen::MatrixX3d& rest = sim.node_points_rest();
   const Eigen::Vector2d expected = length * elastica_tip(alpha);
   CantileverResult out{-1.0, -1.0, sim.kinetic_energy(), sim.max_membrane_strain()};
   for (int v = 0; v < sim.num_vertices(); ++v)

@@ -51,15 +51,15 @@ TEST(CholeskyPreconditioned, MatchesTheDirectSolveAndReusesTheFactor) {
     iterations += s.solver_iterations;
     EXPECT_LE(s.residual, p.solver.tolerance) << "step " << s.step;
   }
-  const Eigen::MatrixX3d moved = direct.state().x - p.mesh.vertices;
+  const Eigen::MatrixX3d moved = direct.state().positions() - p.mesh.vertices;
   const double size = moved.cwiseAbs().maxCoeff();
   ASSERT_GT(size, 1e-2);  // the sleeve has swung with its rim: the elements turned
-  EXPECT_LT((pcg.state().x - direct.state().x).cwiseAbs().maxCoeff(), 1e-9 * size);  // measured 2.7e-13
+  EXPECT_LT((pcg.state().positions() - direct.state().positions()).cwiseAbs().maxCoeff(), 1e-9 * size);  // measured 2.7e-13
   // The factor is reused over several steps and refreshed when the matrix has drifted (on this
   // small mesh a factorisation costs only a few iterations, so the rule refreshes it often:
   // measured 20 factorisations in 40 steps, 282 iterations).
   std::printf("%d steps: %d factorisations, %d PCG iterations, max difference %.2g of the motion\n", direct.num_steps(),
-              factorizations, iterations, (pcg.state().x - direct.state().x).cwiseAbs().maxCoeff() / size);
+              factorizations, iterations, (pcg.state().positions() - direct.state().positions()).cwiseAbs().maxCoeff() / size);
   EXPECT_GE(factorizations, 2);
   EXPECT_LT(factorizations, 3 * direct.num_steps() / 4);
   EXPECT_GT(iterations, direct.num_steps());  // a stale factor is not exact

@@ -70,10 +70,10 @@ TEST(Dynamics, FreeFallMatchesImplicitEulerClosedForm) {
     const int n = sim.num_steps();
     const double h = p.time.dt;
     const Eigen::Vector3d expected = h * h * p.gravity * n * (n + 1) / 2.0;
-    const Eigen::MatrixX3d moved = sim.state().x - p.mesh.vertices;
+    const Eigen::MatrixX3d moved = sim.state().positions() - p.mesh.vertices;
     for (int v = 0; v < sim.num_vertices(); ++v) {
       ASSERT_LT((moved.row(v).transpose() - expected).norm(), 1e-12) << "vertex " << v;
-      ASSERT_LT((sim.state().v.row(v).transpose() - n * h * p.gravity).norm(), 1e-10) << "vertex " << v;
+      ASSERT_LT((sim.state().velocities().row(v).transpose() - n * h * p.gravity).norm(), 1e-10) << "vertex " << v;
     }
   }
 }
@@ -91,11 +91,11 @@ TEST(Dynamics, SpinningFreeSleeveStaysUndeformed) {
   p.solver.newton_iterations = 3;
   Simulator sim(p);
   for (int i = 0; i < sim.num_steps(); ++i) sim.step();
-  const double residual = rigid_residual(p.mesh.vertices, sim.state().x);
+  const double residual = rigid_residual(p.mesh.vertices, sim.state().positions());
   std::printf("spinning sleeve after %d steps: rigid residual %.3e of its size\n", sim.num_steps(), residual);
   EXPECT_LT(residual, 1e-6);
   // It really turned.
-  EXPECT_GT((sim.state().x - p.mesh.vertices).rowwise().norm().maxCoeff(), 0.05);
+  EXPECT_GT((sim.state().positions() - p.mesh.vertices).rowwise().norm().maxCoeff(), 0.05);
 }
 
 TEST(Dynamics, LinearElementDistortsUnderTheSameSpin) {
@@ -108,7 +108,7 @@ TEST(Dynamics, LinearElementDistortsUnderTheSameSpin) {
   p.corotational = false;
   Simulator sim(p);
   for (int i = 0; i < sim.num_steps(); ++i) sim.step();
-  EXPECT_GT(rigid_residual(p.mesh.vertices, sim.state().x), 1e-3);
+  EXPECT_GT(rigid_residual(p.mesh.vertices, sim.state().positions()), 1e-3);
 }
 
 TEST(Dynamics, LinearMomentumIsConservedWithoutExternalForces) {
@@ -118,7 +118,7 @@ TEST(Dynamics, LinearMomentumIsConservedWithoutExternalForces) {
   p.time.end = 0.2;
   p.solver.type = LinearSolverType::cholmod;
   Simulator sim(p);
-  auto momentum = [&] { return Eigen::Vector3d(sim.state().v.transpose() * sim.vertex_mass()); };
+  auto momentum = [&] { return Eigen::Vector3d(sim.state().velocities().transpose() * sim.vertex_mass()); };
   const Eigen::Vector3d p0 = momentum();
   double deformation = 0.0;
   for (int i = 0; i < sim.num_steps(); ++i) {
@@ -188,15 +188,15 @@ TEST(Dynamics, ScriptedVerticesFollowTheirMotionExactly) {
     const double t = sim.state().t;
     for (int v : top.vertices) {
       const Eigen::Vector3d expected = apply_motions(top.motion, p.mesh.vertices.row(v).transpose(), t);
-      ASSERT_LT((sim.state().x.row(v).transpose() - expected).norm(), 1e-15) << "vertex " << v << " t " << t;
+      ASSERT_LT((sim.state().positions().row(v).transpose() - expected).norm(), 1e-15) << "vertex " << v << " t " << t;
     }
-    for (int v : bottom.vertices) ASSERT_EQ(sim.state().x.row(v), p.mesh.vertices.row(v));
+    for (int v : bottom.vertices) ASSERT_EQ(sim.state().positions().row(v), p.mesh.vertices.row(v));
   }
   // The chain ends rotated by 90° and pushed down 3 cm.
   const int v = top.vertices.front();
   const Eigen::Vector3d r = p.mesh.vertices.row(v);
-  EXPECT_NEAR(sim.state().x(v, 0), -r(2) * 1.0 + 0.0 * r(0), 1e-12);
-  EXPECT_NEAR(sim.state().x(v, 1), 0.2 - 0.03, 1e-12);
+  EXPECT_NEAR(sim.state().positions()(v, 0), -r(2) * 1.0 + 0.0 * r(0), 1e-12);
+  EXPECT_NEAR(sim.state().positions()(v, 1), 0.2 - 0.03, 1e-12);
 }
 
 // The extrapolated start of the conjugate gradients (v + (v − v_prev)) against the last velocity:
@@ -221,7 +221,7 @@ TEST(Dynamics, ExtrapolatedStartSavesIterationsNotAccuracy) {
     p.solver.extrapolated_start = extrapolated == 1;
     Simulator sim(p);
     for (int i = 0; i < sim.num_steps(); ++i) iterations[extrapolated] += sim.step().solver_iterations;
-    x[extrapolated] = sim.state().x;
+    x[extrapolated] = sim.state().positions();
   }
   EXPECT_LT(iterations[1], 0.9 * iterations[0]) << iterations[1] << " vs " << iterations[0];
   EXPECT_LT((x[1] - x[0]).cwiseAbs().maxCoeff(), 1e-9) << "the motion itself changed";
@@ -256,7 +256,7 @@ TEST(Dynamics, ScriptedMotionOutlivesTheCallersProblem) {
   }
   for (int i = 0; i < sim->num_steps(); ++i) sim->step();
   for (int v : top_vertices)
-    EXPECT_LT((sim->state().x.row(v) - rest.row(v) - push.displacement.transpose()).norm(), 1e-15) << "vertex " << v;
+    EXPECT_LT((sim->state().positions().row(v) - rest.row(v) - push.displacement.transpose()).norm(), 1e-15) << "vertex " << v;
 }
 
 TEST(Corotation, RotationOfARigidlyRotatedAndStretchedFrame) {

@@ -53,8 +53,8 @@ StripResult bend_strip(double theta, int along) {
   Simulator sim(p);
   for (int i = 0; i < sim.num_steps(); ++i) sim.step();
 
-  const Eigen::MatrixX3d x = sim.limit_positions();
-  const Eigen::MatrixX3d& rest = sim.limit_rest();
+  const Eigen::MatrixX3d x = sim.node_points();
+  const Eigen::MatrixX3d& rest = sim.node_points_rest();
   const double kappa = theta / length;
   StripResult out{0.0, 0.0, sim.kinetic_energy()};
   for (int v = 0; v < sim.num_vertices(); ++v) {

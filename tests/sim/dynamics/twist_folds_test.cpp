@@ -48,7 +48,7 @@ Wave mid_height_wave(double twist_deg, bool sliding_rim = true) {
   for (int i = 0; i < sim.num_steps(); ++i) sim.step();
 
   // Radii of the limit points of the middle ring, and their discrete Fourier modes.
-  const Eigen::MatrixX3d x = sim.limit_positions();
+  const Eigen::MatrixX3d x = sim.node_points();
   const int ring = rings / 2;
   std::vector<double> r(segments);
   Wave out;

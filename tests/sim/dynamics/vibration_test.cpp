@@ -67,7 +67,7 @@ std::vector<double> run(const Problem& p, int probe) {
   w.reserve(sim.num_steps());
   for (int i = 0; i < sim.num_steps(); ++i) {
     sim.step();
-    w.push_back(-(sim.state().x(probe, 2) - p.mesh.vertices(probe, 2)));
+    w.push_back(-(sim.state().positions()(probe, 2) - p.mesh.vertices(probe, 2)));
   }
   return w;
 }

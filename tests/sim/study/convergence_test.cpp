@@ -2,6 +2,7 @@
 // points and the limit-surface sampling operator (rigid motions, seam, agreement with the limit
 // points of solve_static), the relative RMS norm, the plate series (error falls at second order),
 // a tiny sleeve series against its reference, the method registry, and the CSV columns.
+#include "sim/discretization/loop_shell.hpp"
 #include "sim/study/convergence.hpp"
 
 #include "sim/mesh/generators.hpp"
@@ -68,19 +69,20 @@ TEST(SurfaceSampling, PointOutsideTheMeshIsAnError) {
 // motion of the rest limit points: W (Q X + c − X) = (Q − I) W X + c (the rows of W sum to 1).
 TEST(SurfaceSampling, RigidMotionGivesItsOwnDisplacement) {
   const TriMesh mesh = make_cylinder(0.05, 0.2, 13, 10);
-  const ExtendedMesh ext = build_ghost_layer(mesh);
+  const LoopShellDiscretization d(mesh, {}, ShellMaterial{}, Quadrature::one_point);
   const std::vector<SurfaceSample> points = cylinder_points(mesh, 32, 16);
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> w = limit_sampling_matrix(ext, points);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor>& w = d.samples(points).position;
+  const Eigen::MatrixX3d net = d.control_net(d.rest());
   ASSERT_EQ(w.rows(), 32 * 16);
-  ASSERT_EQ(w.cols(), ext.num_vertices());
+  ASSERT_EQ(w.cols(), net.rows());
   const Eigen::VectorXd row_sums = w * Eigen::VectorXd::Ones(w.cols());
   EXPECT_LT((row_sums.array() - 1.0).abs().maxCoeff(), 1e-14);
 
   const Eigen::Matrix3d q = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, -0.5).normalized()).toRotationMatrix();
   const Eigen::RowVector3d c(0.03, -0.2, 0.11);
-  const Eigen::MatrixX3d moved = (ext.rest * q.transpose()).rowwise() + c;
-  const Eigen::MatrixX3d u = w * (moved - ext.rest);
-  const Eigen::MatrixX3d rest_points = w * ext.rest;
+  const Eigen::MatrixX3d moved_nodes = (mesh.vertices * q.transpose()).rowwise() + c;
+  const Eigen::MatrixX3d u = w * (d.control_net(to_flat(moved_nodes)) - net);
+  const Eigen::MatrixX3d rest_points = w * net;
   const Eigen::MatrixX3d expected = (rest_points * (q - Eigen::Matrix3d::Identity()).transpose()).rowwise() + c;
   EXPECT_LT((u - expected).cwiseAbs().maxCoeff(), 1e-12);
   // The rest limit points lie close to the cylinder (the limit surface of a coarse polygon sits
@@ -99,8 +101,9 @@ TEST(SurfaceSampling, PlateCentreMatchesTheLimitDisplacementOfTheCentreVertex) {
   const StaticResult result = solve_static(problem);
   const Eigen::MatrixX2d chart = problem.mesh.vertices.leftCols<2>();
   const std::vector<SurfaceSample> centre = locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
-  const Eigen::MatrixX3d u =
-      limit_sampling_matrix(build_ghost_layer(problem.mesh), centre) * result.extended_displacement;
+  const Discretization& d = *result.discretization;
+  const SurfaceOperator sample = d.samples(centre);
+  const Eigen::MatrixX3d u = d.surface_positions(sample, result.positions()) - d.surface_positions(sample, d.rest());
   const int vertex = nearest_vertex(problem.mesh, Eigen::Vector3d::Zero());
   EXPECT_NEAR(u(0, 2), result.limit_displacement(vertex, 2), 1e-12 * std::abs(result.limit_displacement(vertex, 2)));
 }
