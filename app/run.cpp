@@ -149,6 +149,7 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     apply_end_option(scene, options);
     if (options.width > 0) scene.render.width = options.width;
     if (options.height > 0) scene.render.height = options.height;
+    if (options.framing) scene.render.framing = *options.framing == "sequence" ? Framing::sequence : Framing::motion;
     if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root, options.render, options.video);
 
     StaticResult result;
