@@ -207,8 +207,9 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
     RenderSettings settings;
     if (width > 0) settings.width = width;
     if (height > 0) settings.height = height;
+    // Two passes over the files, so that only one frame is in memory at a time: the bounds of the
+    // whole sequence for the camera, then the pictures.
     std::unique_ptr<LimitSurfaceDrawer> drawer;
-    std::vector<SurfaceSnapshot> snapshots;
     render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
     std::vector<Triangle> first_triangles;
     for (const fs::path& file : files) {
@@ -219,17 +220,20 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
       } else if (mesh.triangles != first_triangles) {
         throw std::runtime_error(file.string() + ": its triangles differ from " + files.front().string());
       }
-      snapshots.push_back(drawer->snapshot(build_ghost_layer(mesh).rest));
-      LimitSurfaceDrawer::extend_bounds(snapshots.back(), lo, hi);
+      LimitSurfaceDrawer::extend_bounds(drawer->snapshot(build_ghost_layer(mesh).rest), lo, hi);
     }
     render::Renderer renderer(settings.width, settings.height);
     const render::Camera camera = drawer->camera(lo, hi);
-    for (std::size_t k = 0; k < snapshots.size(); ++k) {
+    for (std::size_t k = 0; k < files.size(); ++k) {
+      const TriMesh mesh = read_obj(files[k].string());
+      if (mesh.triangles != first_triangles)  // changed since the first pass
+        throw std::runtime_error(files[k].string() + ": its triangles differ from " + files.front().string());
       char name[32];
       std::snprintf(name, sizeof(name), "frame_%04zu.png", k);
-      render::write_png((dir / name).string(), renderer.render(drawer->frame(snapshots[k], camera, lo[1])));
+      const SurfaceSnapshot snapshot = drawer->snapshot(build_ghost_layer(mesh).rest);
+      render::write_png((dir / name).string(), renderer.render(drawer->frame(snapshot, camera, lo[1])));
     }
-    std::cout << "rendered " << snapshots.size() << " frame(s) from " << frames.string() << " to "
+    std::cout << "rendered " << files.size() << " frame(s) from " << frames.string() << " to "
               << (dir / "frame_*.png").string() << "\n";
     return 0;
   } catch (const std::exception& e) {
