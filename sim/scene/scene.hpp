@@ -46,7 +46,7 @@ struct RenderSettings {
   Eigen::Vector3d back_color{0.5, 0.1, 0.1};  // back faces
   Eigen::Vector3d background{1, 1, 1};
   bool wireframe = false;  // overlay the control mesh
-  bool ground = false;     // a ground plane below the animation's bounds
+  bool ground = false;     // a ground plane at the bottom of the framed box (see `framing`)
   bool has_camera = false;  // otherwise framed automatically, see `framing`
   Eigen::Vector3d eye{0, 0, 1}, target{0, 0, 0}, up{0, 1, 0};  // [m]
   double fov_deg = 35.0;   // vertical field of view [deg]
