@@ -276,6 +276,23 @@ TEST_F(FrameImagesTest, SequenceFramingDrawsAfterTheRunAndRemovesItsSpool) {
     EXPECT_NE(e.path().filename().string().front(), '.') << "left behind: " << e.path();
 }
 
+TEST_F(FrameImagesTest, RepeatedFramesInBothFramings) {
+  // Steps of 2 ms and frames every 1 ms: frames 1 and 2 both show the state after the first step.
+  std::string text = falling_cloth();
+  const std::string time = R"("time": {"dt": 0.001, "end": 0.01, "output_fps": 500})";
+  text.replace(text.find(time), time.size(), R"("time": {"dt": 0.002, "end": 0.01, "output_fps": 1000})");
+  const fs::path scene = write("steps.json", text);
+  for (const std::string framing : {"motion", "sequence"}) {
+    SCOPED_TRACE(framing);
+    const RunResult r = run(scene, "--framing " + framing);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const fs::path run_dir = out_ / "cloth";
+    ASSERT_EQ(frame_files(run_dir).size(), 11u);  // t = 0, 1, ..., 10 ms
+    EXPECT_EQ(read_file_bytes(run_dir / "frame_0001.png"), read_file_bytes(run_dir / "frame_0002.png"));
+    EXPECT_NE(read_file_bytes(run_dir / "frame_0002.png"), read_file_bytes(run_dir / "frame_0003.png"));
+  }
+}
+
 TEST_F(FrameImagesTest, FailedRunHasPicturesOfItsFramesInBothFramings) {
   // A stiff sheet with a huge step and a conjugate gradient solver allowed one iteration: the
   // first step fails; frame 0 (the initial state) was produced before.
