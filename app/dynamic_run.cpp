@@ -1,11 +1,12 @@
 // The dynamic part of the clothsim command: builds the Simulator, then steps it while streaming
-// probes.csv, stats.csv and OBJ frames (flushed every step, so a failed or interrupted run keeps
-// what it has written) and finally summary.json (replaced atomically).
+// probes.csv, stats.csv, OBJ frames and (with motion framing) PNG frames (flushed every step, so a
+// failed or interrupted run keeps what it has written) and finally summary.json (replaced
+// atomically). The Simulator is used in this file only.
 #include "app/dynamic_run.hpp"
 
+#include "app/frame_images.hpp"
 #include "app/limit_surface_drawer.hpp"
 #include "app/output_folders.hpp"
-#include "render/png_io.hpp"
 #include "render/renderer.hpp"
 
 #include "sim/dynamics/simulator.hpp"
@@ -171,8 +172,9 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
 // The streamed outputs of one run.
 class Outputs {
  public:
-  Outputs(const Scene& scene, const fs::path& dir, const LimitSurfaceDrawer* drawer)
-      : scene_(scene), dir_(dir), drawer_(drawer), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
+  // `images`: the PNG frames, or null for none.
+  Outputs(const Scene& scene, const fs::path& dir, FrameImages* images)
+      : scene_(scene), dir_(dir), images_(images), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms");
     probes_.flush();
@@ -183,7 +185,7 @@ class Outputs {
   // Probe rows and due frames for the state reached after `step` steps, at time `t` [s].
   void record_state(const Simulator& sim, int step, double t, RunTotals& totals) {
     const TimeSettings& time = scene_.problem.time;
-    const bool frames_wanted = scene_.write_obj_frames || drawer_ != nullptr;
+    const bool frames_wanted = scene_.write_obj_frames || images_ != nullptr;
     const bool frame_due = frames_wanted && t >= totals.frames / time.output_fps - 1e-9 * time.dt;
     if (scene_.probes.empty() && !frame_due) return;
     if (!scene_.probes.empty()) {
@@ -205,6 +207,7 @@ class Outputs {
     }
     // Frame k belongs to the first state with t >= k / fps; a step longer than a frame period
     // repeats the frame so that frame k always shows time ≈ k / fps.
+    bool repeated = false;
     while (frames_wanted && t >= totals.frames / time.output_fps - 1e-9 * time.dt) {
       if (scene_.write_obj_frames) {
         char file[32];
@@ -214,31 +217,13 @@ class Outputs {
                                     ", t = " + format_double(t) + " s";
         write_obj((dir_ / "frames" / file).string(), sim.node_points(), scene_.problem.mesh.triangles, comment);
       }
-      if (drawer_) {
-        if (snapshots_.size() == static_cast<std::size_t>(totals.frames)) {
-          snapshots_.push_back(drawer_->snapshot(sim.state().x));
-          LimitSurfaceDrawer::extend_bounds(snapshots_.back(), lo_, hi_);
-        } else {
-          snapshots_.push_back(snapshots_.back());  // a repeated frame
-        }
+      if (images_) {
+        if (repeated) images_->repeat();
+        else images_->add(sim.state().x);
       }
+      repeated = true;
       ++totals.frames;
     }
-  }
-
-  // Draws every collected frame with one camera framing the whole sequence:
-  // frame_0000.png, frame_0001.png, ... Returns the number of images written.
-  int render_frames(render::Renderer& renderer) const {
-    if (!drawer_ || snapshots_.empty()) return 0;
-    const render::Camera camera = drawer_->camera(lo_, hi_);
-    int written = 0;
-    for (const SurfaceSnapshot& s : snapshots_) {
-      char file[32];
-      std::snprintf(file, sizeof(file), "frame_%04d.png", written);
-      render::write_png((dir_ / file).string(), renderer.render(drawer_->frame(s, camera, lo_[1])));
-      ++written;
-    }
-    return written;
   }
 
   void record_stats(const StepStats& s) {
@@ -256,11 +241,9 @@ class Outputs {
  private:
   const Scene& scene_;
   fs::path dir_;
-  const LimitSurfaceDrawer* drawer_;
-  std::vector<SurfaceSnapshot> snapshots_;
+  FrameImages* images_;
   SurfaceOperator probe_points_;  // the probes' surface points
   Eigen::MatrixX3d probe_rest_;   // their rest positions [m]
-  render::Vec3f lo_{1e30f, 1e30f, 1e30f}, hi_{-1e30f, -1e30f, -1e30f};
   StreamFile probes_;
   StreamFile stats_;
 };
@@ -350,11 +333,14 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
   // The renderer and the refinement operator, also before any file is written.
   std::unique_ptr<LimitSurfaceDrawer> drawer;
   std::unique_ptr<render::Renderer> renderer;
+  Bounds motion_bounds;  // motion framing: the box framed by the camera
   if (render_frames) {
     try {
       drawer = std::make_unique<LimitSurfaceDrawer>(sim->discretization(), scene.render, scene.render.width,
                                                     scene.render.height);
       renderer = std::make_unique<render::Renderer>(scene.render.width, scene.render.height);
+      if (scene.render.framing == Framing::motion)
+        motion_bounds = motion_framing_bounds(*drawer, sim->discretization().rest(), scene.problem);
     } catch (const std::exception& e) {
       throw std::runtime_error(file + ": cannot set up rendering: " + e.what() + " (use --no-render to skip images)");
     }
@@ -374,10 +360,13 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
 
   RunTotals totals;
   std::string failure;  // the error message of a failed run
+  std::unique_ptr<FrameImages> images;
   std::unique_ptr<Outputs> outputs;
   try {
     write_atomically(dir / "summary.json", summary_json(scene, totals, seconds_since(start), warnings, "running", ""));
-    outputs = std::make_unique<Outputs>(scene, dir, drawer.get());
+    if (drawer)
+      images = std::make_unique<FrameImages>(*drawer, *renderer, scene.render.framing, motion_bounds, dir);
+    outputs = std::make_unique<Outputs>(scene, dir, images.get());
     outputs->record_state(*sim, 0, sim->state().t, totals);
     Progress progress(steps, scene.problem.time.output_fps);
     for (int k = 1; k <= steps; ++k) {
@@ -403,13 +392,15 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
     failure = e.what();
   }
 
-  // Images of the frames simulated so far (also after a failure), with one camera for all.
-  if (outputs && renderer) {
+  // Sequence framing: the images of the frames simulated so far (also after a failure), with one
+  // camera for all; motion framing has written them already.
+  if (images) {
     try {
-      const int images = outputs->render_frames(*renderer);
-      log_line("rendered " + std::to_string(images) + " frame(s) of " + std::to_string(drawer->fine_triangles()) +
+      const int written = images->finish();
+      log_line(std::string(scene.render.framing == Framing::motion ? "wrote " : "rendered ") +
+               std::to_string(written) + " frame(s) of " + std::to_string(drawer->fine_triangles()) +
                " triangles to " + (dir / "frame_*.png").string());
-      if (video && images > 0) encode_video(dir, scene.name, scene.problem.time.output_fps);
+      if (video && written > 0) encode_video(dir, scene.name, scene.problem.time.output_fps);
     } catch (const std::exception& e) {
       if (failure.empty()) failure = std::string("rendering failed: ") + e.what();
       else log_line("warning: rendering failed: " + std::string(e.what()));

@@ -1,5 +1,6 @@
 // Running a dynamic scene from the command line: the Simulator steps to time.end while probes.csv,
-// stats.csv, OBJ frames and summary.json are streamed into DIR/<name>/ (contract in
+// stats.csv, OBJ frames, PNG frames (render.framing "motion"; "sequence" draws them after the run,
+// see app/frame_images.hpp) and summary.json are streamed into DIR/<name>/ (contract in
 // scenes/README.md, "Outputs of a dynamic run").
 #pragma once
 

@@ -1,7 +1,8 @@
 // The adapter between the simulation and the renderer: turns node positions into plain
 // render::Frame data — the surface refined `render.refine` times (positions and normals from the
 // discretisation's display operator, built once), the control mesh as an optional wireframe, the
-// scene's colours and a camera (given, or framed once over the bounds of a whole sequence).
+// scene's colours and a camera (given, or framed once on a box: a whole sequence's bounds, or the
+// box known before a run, see app/frame_images.hpp).
 #pragma once
 
 #include "render/frame.hpp"

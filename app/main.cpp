@@ -94,12 +94,20 @@ int main(int argc, char** argv) {
   CLI::Option* frames_option =
       app.add_option("--frames", frames, "Dynamic scenes: simulate just long enough for N frames")->type_name("N");
   app.add_option("--size", size, "Image size, e.g. 960x720 (replaces render.width/height)")->type_name("WxH");
+  std::string framing;
+  app.add_option("--framing", framing,
+                 "Dynamic scenes: 'motion' fixes the camera before the run (the scene's, or one framing\n"
+                 "the rest shape and the boundary motions) and writes each PNG as its frame is produced;\n"
+                 "'sequence' frames the whole run and writes the PNGs after it (replaces render.framing)")
+      ->check(CLI::IsMember({"motion", "sequence"}))
+      ->type_name("MODE");
   if (const int code = parse(app, argc, argv); code >= 0) return code;
   clothsim::RunOptions options;
   if (end_option->count() > 0) options.end = end;
   options.render = !no_render;
   options.video = video;
   if (frames_option->count() > 0) options.frames = frames;
+  if (!framing.empty()) options.framing = framing;
   if (!size.empty()) {
     const auto x = size.find('x');
     try {

@@ -150,6 +150,7 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     apply_end_option(scene, options);
     if (options.width > 0) scene.render.width = options.width;
     if (options.height > 0) scene.render.height = options.height;
+    if (options.framing) scene.render.framing = *options.framing == "sequence" ? Framing::sequence : Framing::motion;
     if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root, options.render, options.video);
 
     StaticResult result;
@@ -206,9 +207,10 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
     RenderSettings settings;
     if (width > 0) settings.width = width;
     if (height > 0) settings.height = height;
+    // Two passes over the files, so that only one frame is in memory at a time: the bounds of the
+    // whole sequence for the camera, then the pictures.
     std::unique_ptr<LoopShellDiscretization> surface;  // the saved mesh as a Loop control mesh
     std::unique_ptr<LimitSurfaceDrawer> drawer;
-    std::vector<SurfaceSnapshot> snapshots;
     render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
     std::vector<Triangle> first_triangles;
     for (const fs::path& file : files) {
@@ -221,17 +223,20 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
       } else if (mesh.triangles != first_triangles) {
         throw std::runtime_error(file.string() + ": its triangles differ from " + files.front().string());
       }
-      snapshots.push_back(drawer->snapshot(to_flat(mesh.vertices)));
-      LimitSurfaceDrawer::extend_bounds(snapshots.back(), lo, hi);
+      LimitSurfaceDrawer::extend_bounds(drawer->snapshot(to_flat(mesh.vertices)), lo, hi);
     }
     render::Renderer renderer(settings.width, settings.height);
     const render::Camera camera = drawer->camera(lo, hi);
-    for (std::size_t k = 0; k < snapshots.size(); ++k) {
+    for (std::size_t k = 0; k < files.size(); ++k) {
+      const TriMesh mesh = read_obj(files[k].string());
+      if (mesh.triangles != first_triangles)  // changed since the first pass
+        throw std::runtime_error(files[k].string() + ": its triangles differ from " + files.front().string());
       char name[32];
       std::snprintf(name, sizeof(name), "frame_%04zu.png", k);
-      render::write_png((dir / name).string(), renderer.render(drawer->frame(snapshots[k], camera, lo[1])));
+      const SurfaceSnapshot snapshot = drawer->snapshot(to_flat(mesh.vertices));
+      render::write_png((dir / name).string(), renderer.render(drawer->frame(snapshot, camera, lo[1])));
     }
-    std::cout << "rendered " << snapshots.size() << " frame(s) from " << frames.string() << " to "
+    std::cout << "rendered " << files.size() << " frame(s) from " << frames.string() << " to "
               << (dir / "frame_*.png").string() << "\n";
     return 0;
   } catch (const std::exception& e) {

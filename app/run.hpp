@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 namespace clothsim {
 
@@ -14,6 +15,7 @@ struct RunOptions {
   int width = 0, height = 0;  // --size WxH: replaces render.width/height (0: keep)
   std::optional<int> frames;  // --frames N: simulate just long enough for N frames
   bool video = false;         // --video: also encode DIR/<name>/<name>.mp4 with ffmpeg
+  std::optional<std::string> framing;  // --framing motion|sequence: replaces render.framing
 };
 
 // `clothsim render DIR`: draws DIR/frames/mesh_*.obj again into DIR/frame_NNNN.png.

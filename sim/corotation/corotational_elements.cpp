@@ -377,7 +377,7 @@ void CorotationalElements::evaluate(const Eigen::VectorXd& u) {
           x.segment<3>(3 * p) = rest_patch_.segment<3>(offset + 3 * p) + u.segment<3>(3 * static_cast<Eigen::Index>(vertex[p]));
       else
         x = rest_patch_.segment(offset, 3 * np) + model_.patch_vector(static_cast<int>(e), u);
-      if (!corotational_) continue;
+      if (!corotational_ || frozen_rotations_) continue;
       const double* rows = tangent_rows_.data() + 2 * (offset / 3);
       Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
       for (Eigen::Index p = 0; p < np; ++p) {
@@ -451,6 +451,19 @@ void CorotationalElements::add_stiffness(double scale, Eigen::SparseMatrix<doubl
   });
 }
 
+void CorotationalElements::set_stiffness(double scale, Eigen::SparseMatrix<double>& k) const {
+  if (folded_groups_.empty()) {
+    accumulate_stiffness(scale, /*overwrite=*/true, k.valuePtr());
+    return;
+  }
+  scratch_.resize(static_cast<size_t>(k.nonZeros()));
+  accumulate_stiffness(1.0, /*overwrite=*/true, scratch_.data());
+  double* values = k.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, scratch_.size(), 1 << 14), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t i = range.begin(); i != range.end(); ++i) values[i] = scale * scratch_[i];
+  });
+}
+
 void CorotationalElements::accumulate_stiffness(double scale, bool overwrite, double* values) const {
   const auto sum = assembly_avx2::supported() ? assembly_avx2::sum_block : assembly_avx2::sum_block_portable;
   const double* rotations = rotation_.empty() ? nullptr : rotation_.front().data();  // Matrix3d: 9 contiguous values each
@@ -518,6 +531,29 @@ void CorotationalElements::accumulate_stiffness(double scale, bool overwrite, do
             model_.add_block(e, a, b, scale * folded.block<3, 3>(3 * static_cast<Eigen::Index>(a), 3 * static_cast<Eigen::Index>(b)), values);
       }
     });
+}
+
+Eigen::VectorXd CorotationalElements::tension_force(const Eigen::VectorXd& u) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(u.size());
+  const std::vector<ShellElement>& elements = model_.elements();
+  for (size_t e = 0; e < elements.size(); ++e) {
+    const Eigen::Index np = (patch_offset_[e + 1] - patch_offset_[e]) / 3;
+    const Eigen::VectorXd x = rest_patch_.segment(patch_offset_[e], 3 * np) + model_.patch_vector(static_cast<int>(e), u);
+    Eigen::VectorXd local = Eigen::VectorXd::Zero(3 * np);
+    for (int q = point_offset_[e]; q < point_offset_[e + 1]; ++q) {
+      const BasisMatrix& basis = elements[e].basis[static_cast<size_t>(q - point_offset_[e])];
+      Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
+      for (Eigen::Index p = 0; p < np; ++p) {
+        a1 += basis(1, p) * x.segment<3>(3 * p);
+        a2 += basis(2, p) * x.segment<3>(3 * p);
+      }
+      const double* t = tension_.data() + 3 * static_cast<size_t>(q);  // w j n₊¹¹, n₊¹², n₊²²
+      const Eigen::Vector3d s1 = t[0] * a1 + t[1] * a2, s2 = t[1] * a1 + t[2] * a2;
+      for (Eigen::Index p = 0; p < np; ++p) local.segment<3>(3 * p) -= basis(1, p) * s1 + basis(2, p) * s2;
+    }
+    model_.add_patch_vector(static_cast<int>(e), local, f);
+  }
+  return f;
 }
 
 Eigen::MatrixX2d CorotationalElements::membrane_principal_strains(const Eigen::VectorXd& u) const {

@@ -53,6 +53,8 @@ class CorotationalElements {
   void assemble_stiffness(Eigen::SparseMatrix<double>& k) const;
   // k += scale · Σ R K_e Rᵀ (with the tension stiffening when on); `k` has the model's pattern.
   void add_stiffness(double scale, Eigen::SparseMatrix<double>& k) const;
+  // k = scale · Σ R K_e Rᵀ (every value written; no clearing pass needed).
+  void set_stiffness(double scale, Eigen::SparseMatrix<double>& k) const;
   // Energy and force of one element for a given rotation (patch coordinates): for tests.
   double element_energy(int e, const Eigen::Matrix3d& r, const Eigen::VectorXd& x_patch) const;
   Eigen::VectorXd element_force(int e, const Eigen::Matrix3d& r, const Eigen::VectorXd& x_patch) const;
@@ -66,6 +68,15 @@ class CorotationalElements {
 
   // Include the tension-stiffening term (default true).
   void set_geometric_stiffness(bool on) { tension_stiffening_ = on; }
+  // Keep the rotations of the last evaluate() in later ones (default false): the forces are then
+  // those of the frozen-R linearisation, whose exact Jacobian is the assembled Σ R K_e Rᵀ (for
+  // derivative checks).
+  void set_frozen_rotations(bool on) { frozen_rotations_ = on; }
+
+  // The tension force of the last evaluate()'s tensile membrane forces n₊ held fixed, at
+  // displacements u (3·#V): f_T = −∂Φ/∂x with Φ = ½ Σ_q w_q j n₊^{αβ} a_α·a_β, a_α = Σ N_I,α x_I.
+  // Its exact Jacobian is minus the tension-stiffening matrix G (for derivative checks) [N].
+  Eigen::VectorXd tension_force(const Eigen::VectorXd& u) const;
 
   double last_rotate_ms() const { return rotate_ms_; }
   double total_rotate_ms() const { return total_rotate_ms_; }  // over every evaluate() so far
@@ -108,6 +119,7 @@ class CorotationalElements {
   // stiffness G_ab = Σ_q w (N_a,α n₊^{αβ} N_b,β) is formed from these where it is assembled.
   std::vector<double> tension_;
   bool tension_stiffening_ = true;
+  bool frozen_rotations_ = false;
   // Assembly as a gather (identity elements, and folded ones whose fold treats the three
   // components alike: see build_assembly). Every block (I, J), I ≤ J, of the matrix
   // pattern sums its element blocks R K_ab Rᵀ (K_ab stored already oriented as (I, J)) in

@@ -95,6 +95,7 @@ Simulator::~Simulator() = default;
 
 void Simulator::add_term(std::unique_ptr<ForceTerm> term) {
   Impl& m = *impl_;
+  if (!term) throw std::invalid_argument("Simulator::add_term: no term");
   if (m.state.step > 0) throw std::logic_error("Simulator::add_term: only before the first step");
   m.internal.push_back(std::move(term));
   m.build_integrator();

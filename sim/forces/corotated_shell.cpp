@@ -21,4 +21,8 @@ void CorotatedShell::add_matrix(const MatrixWeights& w, Eigen::SparseMatrix<doub
   if (w.stiffness != 0.0) elements_.add_stiffness(w.stiffness, a);
 }
 
+void CorotatedShell::set_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const {
+  elements_.set_stiffness(w.stiffness, a);
+}
+
 }  // namespace clothsim

@@ -25,9 +25,13 @@ class CorotatedShell final : public ForceTerm {
   void add_force(Eigen::VectorXd& f) const override { f += elements_.force(); }
   bool has_matrix() const override { return true; }
   void add_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const override;
+  void set_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const override;
 
   // The element work underneath: rotations, strains, timings of the last evaluation.
   const CorotationalElements& elements() const { return elements_; }
+  // Keep the current rotations in later updates (the frozen-R forces whose exact Jacobian is the
+  // matrix without tension stiffening: for derivative checks).
+  void freeze_rotations(bool on) { elements_.set_frozen_rotations(on); }
   // Time of the last update()'s rotation and force passes [ms] (0 when it reused the last state).
   double last_rotate_ms() const { return rotate_ms_; }
   double last_force_ms() const { return force_ms_; }

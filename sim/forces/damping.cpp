@@ -28,6 +28,10 @@ void KelvinVoigtDamping::add_matrix(const MatrixWeights& w, Eigen::SparseMatrix<
   elastic_->add_matrix({w.stiffness + w.damping * coefficient_, w.damping}, a);
 }
 
+void KelvinVoigtDamping::set_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const {
+  elastic_->set_matrix({w.stiffness + w.damping * coefficient_, w.damping}, a);
+}
+
 MassDamping::MassDamping(const Eigen::VectorXd& node_mass, double coefficient, const Eigen::SparseMatrix<double>& pattern)
     : dof_mass_(3 * node_mass.size()), coefficient_(coefficient), diagonal_(diagonal_offsets(pattern)) {
   if (!(coefficient >= 0)) throw std::invalid_argument("mass damping: the coefficient must be >= 0 [1/s]");

@@ -29,6 +29,7 @@ class KelvinVoigtDamping final : public ForceTerm {
   bool has_matrix() const override { return true; }
   // a += (w_K + c w_D) K + w_D D_elastic.
   void add_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const override;
+  void set_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const override;
 
   ForceTerm& elastic() { return *elastic_; }
   const ForceTerm& elastic() const { return *elastic_; }

@@ -16,14 +16,17 @@ bool add_moment_forces(const MomentLoad& load, const Eigen::VectorXd& x, Eigen::
   const double m2 = load.moment.squaredNorm();
   if (m2 == 0.0) return true;
   const Eigen::Vector3d axis = load.moment / std::sqrt(m2);
-  double sum = 0.0;
+  double sum = 0.0, spread = 0.0;
   std::vector<Eigen::Vector3d> r(load.vertices.size());
   for (size_t i = 0; i < load.vertices.size(); ++i) {
     const Eigen::Vector3d d = x.segment<3>(3 * load.vertices[i]) - centroid;
     r[i] = d - axis.dot(d) * axis;
     sum += r[i].squaredNorm();
+    spread += d.squaredNorm();
   }
-  if (!(sum > 0.0)) return false;
+  // Offsets perpendicular to M that are round-off of a group on one line parallel to it would
+  // give forces of order M / 1e-18: such a group cannot carry the moment.
+  if (!(sum > 1e-20 * spread)) return false;
   for (size_t i = 0; i < load.vertices.size(); ++i) f.segment<3>(3 * load.vertices[i]) += load.moment.cross(r[i]) / sum;
   return true;
 }

@@ -21,7 +21,8 @@ struct MomentLoad {
 };
 
 // Adds the couple's nodal forces for positions x (flat, 3·#nodes) [m] to f (3·#nodes) [N].
-// Returns false when the group cannot carry the moment (all offsets parallel to it).
+// Returns false when the group cannot carry the moment (all offsets parallel to it, to 1e-10 of
+// the group's size).
 bool add_moment_forces(const MomentLoad& load, const Eigen::VectorXd& x, Eigen::VectorXd& f);
 
 class FollowerCouples final : public ForceTerm {

@@ -19,6 +19,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <algorithm>
 #include <string>
 
 namespace clothsim {
@@ -57,6 +58,13 @@ class ForceTerm {
   // a += w.stiffness · K + w.damping · D at the last update(). `a` has the discretisation's
   // pattern (compressed, column-major); only its values are touched.
   virtual void add_matrix(const MatrixWeights& /*w*/, Eigen::SparseMatrix<double>& /*a*/) const {}
+  // a = w.stiffness · K + w.damping · D: the same as setting every value of `a` to zero and calling
+  // add_matrix(). The integrator asks the first term for this; a term whose matrix fills the
+  // whole pattern overrides it to save the clearing pass (the corotated shell: 4 % of a step).
+  virtual void set_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const {
+    std::fill(a.valuePtr(), a.valuePtr() + a.nonZeros(), 0.0);
+    add_matrix(w, a);
+  }
 };
 
 }  // namespace clothsim

@@ -59,6 +59,17 @@ void ImplicitEuler::update_terms(const Eigen::VectorXd& x, const Eigen::VectorXd
   for (ForceTerm* term : all_) term->update(x, u, t);
 }
 
+void ImplicitEuler::assemble(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const {
+  bool set = false;  // the first term with a matrix sets the values, the others add to them
+  for (const ForceTerm* term : all_) {
+    if (!term->has_matrix()) continue;
+    if (set) term->add_matrix(w, a);
+    else term->set_matrix(w, a);
+    set = true;
+  }
+  if (!set) clear_values(a);
+}
+
 double ImplicitEuler::kinetic_energy(const DynamicState& state) const { return 0.5 * state.v.dot(mass_.cwiseProduct(state.v)); }
 
 double ImplicitEuler::elastic_energy() const {
@@ -127,17 +138,13 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     t0 = std::chrono::steady_clock::now();
     // The matrix keeps its pattern and storage from step to step; only its values are rewritten.
     Eigen::SparseMatrix<double>& a = system_;
-    clear_values(a);
-    for (const ForceTerm* term : all_)
-      if (term->has_matrix()) term->add_matrix(weights, a);
+    assemble(weights, a);
     f.setZero();
     for (const ForceTerm* term : all_) term->add_force(f);
     Eigen::VectorXd b = mass_.cwiseProduct(v) + h * f;
     if (k > 0) {
       if (stiffness_.size() == 0) stiffness_ = discretization_.matrix_pattern();
-      clear_values(stiffness_);
-      for (const ForceTerm* term : all_)
-        if (term->has_matrix()) term->add_matrix({1.0, 0.0}, stiffness_);
+      assemble({1.0, 0.0}, stiffness_);
       b += h * h * (stiffness_ * v_k);
     }
     double* values = a.valuePtr();

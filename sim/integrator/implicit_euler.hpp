@@ -141,6 +141,8 @@ class ImplicitEuler {
 
  private:
   void update_terms(const Eigen::VectorXd& x, const Eigen::VectorXd& u, double t);
+  // a = Σ over the terms of w.stiffness K + w.damping D.
+  void assemble(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const;
 
   IntegratorSettings settings_;
   const Discretization& discretization_;

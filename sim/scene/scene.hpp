@@ -30,6 +30,14 @@ struct Probe {
   int vertex = -1;                               // nearest control vertex of the prepared mesh
 };
 
+// How a dynamic run's camera is chosen when the scene gives none, and so when its PNG frames are
+// written ("render.framing").
+enum class Framing {
+  motion,    // fixed before the run from the rest shape and the scripted boundary motions (plus a
+             // margin); each frame's picture is written as soon as the frame is produced
+  sequence,  // framed on the bounds of the whole simulated sequence; pictures written after the run
+};
+
 // "render": how the application draws the limit surface (plain settings; sim/ does not render).
 struct RenderSettings {
   int width = 960, height = 720;  // image size [px]
@@ -38,10 +46,11 @@ struct RenderSettings {
   Eigen::Vector3d back_color{0.5, 0.1, 0.1};  // back faces
   Eigen::Vector3d background{1, 1, 1};
   bool wireframe = false;  // overlay the control mesh
-  bool ground = false;     // a ground plane below the animation's bounds
-  bool has_camera = false;  // otherwise framed automatically over the whole animation
+  bool ground = false;     // a ground plane at the bottom of the framed box (see `framing`)
+  bool has_camera = false;  // otherwise framed automatically, see `framing`
   Eigen::Vector3d eye{0, 0, 1}, target{0, 0, 0}, up{0, 1, 0};  // [m]
   double fov_deg = 35.0;   // vertical field of view [deg]
+  Framing framing = Framing::motion;  // dynamic scenes only
 };
 
 struct Scene {

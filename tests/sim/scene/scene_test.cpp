@@ -601,6 +601,17 @@ TEST_F(SceneLoader, DynamicSettingErrors) {
                        expected("material: a dynamic analysis needs a positive areal density")));
 }
 
+TEST_F(SceneLoader, RenderFraming) {
+  EXPECT_EQ(load(std::string("{") + kGrid4 + "}").render.framing, Framing::motion);
+  EXPECT_EQ(load(std::string("{") + kGrid4 + R"(, "render": {"framing": "sequence"}})").render.framing,
+            Framing::sequence);
+  EXPECT_EQ(load(std::string("{") + kGrid4 + R"(, "render": {"framing": "motion"}})").render.framing, Framing::motion);
+  EXPECT_EQ(error(std::string("{") + kGrid4 + R"(, "render": {"framing": "whole"}})"),
+            expected("render.framing: unknown framing \"whole\" (allowed: \"motion\", \"sequence\")"));
+  EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "render": {"framing": 1}})"),
+                       expected("render.framing: expected a string")));
+}
+
 TEST_F(SceneLoader, MotionErrors) {
   auto motion = [&](const std::string& list, const std::string& fix = R"(["x", "y", "z"])") {
     return error(std::string(R"({"analysis": "dynamic", )") + kGrid4 +

@@ -1,0 +1,141 @@
+// The pictures of a dynamic run: drawn one frame at a time as the frames come (motion framing)
+// or after the run from a spool file of control-net positions (sequence framing).
+#include "app/frame_images.hpp"
+
+#include "render/png_io.hpp"
+#include "sim/boundary/motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+namespace clothsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+void extend(Bounds& b, const Eigen::Vector3d& p) {
+  for (int k = 0; k < 3; ++k) {
+    const auto i = static_cast<std::size_t>(k);
+    b.lo[i] = std::min(b.lo[i], static_cast<float>(p(k)));
+    b.hi[i] = std::max(b.hi[i], static_cast<float>(p(k)));
+  }
+}
+
+std::string frame_file(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "frame_%04d.png", frame);
+  return name;
+}
+
+}  // namespace
+
+Bounds motion_framing_bounds(const LimitSurfaceDrawer& drawer, const Eigen::VectorXd& rest, const Problem& problem) {
+  Bounds b;
+  LimitSurfaceDrawer::extend_bounds(drawer.snapshot(rest), b.lo, b.hi);
+  const double end = problem.time.end;
+  for (const BoundaryCondition& bc : problem.boundary) {
+    if (bc.motion.empty()) continue;
+    std::vector<double> times;
+    for (int s = 0; s <= kMotionFramingSamples; ++s) times.push_back(end * s / kMotionFramingSamples);
+    for (const Motion& m : bc.motion)
+      for (double t : {m.start, m.end})
+        if (t > 0 && t < end) times.push_back(t);
+    for (int v : bc.vertices) {
+      const Eigen::Vector3d rest_vertex = problem.mesh.vertices.row(v).transpose();
+      for (double t : times) extend(b, apply_motions(bc.motion, rest_vertex, t));
+    }
+  }
+  float diagonal = 0.0f;
+  for (std::size_t k = 0; k < 3; ++k) diagonal += (b.hi[k] - b.lo[k]) * (b.hi[k] - b.lo[k]);
+  const float margin = kMotionFramingMargin * std::sqrt(diagonal);
+  for (std::size_t k = 0; k < 3; ++k) {
+    b.lo[k] -= margin;
+    b.hi[k] += margin;
+  }
+  return b;
+}
+
+fs::path frame_spool_path(const fs::path& dir) { return dir / ".frames.bin"; }
+
+FrameImages::FrameImages(const LimitSurfaceDrawer& drawer, render::Renderer& renderer, Framing framing,
+                         const Bounds& motion_bounds, fs::path dir)
+    : drawer_(drawer), renderer_(renderer), framing_(framing), dir_(std::move(dir)) {
+  if (framing_ == Framing::motion) {
+    bounds_ = motion_bounds;
+    camera_ = drawer_.camera(bounds_.lo, bounds_.hi);
+  } else {
+    spool_.open(frame_spool_path(dir_), std::ios::binary | std::ios::trunc);
+    if (!spool_) throw std::runtime_error(frame_spool_path(dir_).string() + ": cannot open the file for writing");
+  }
+}
+
+FrameImages::~FrameImages() {
+  if (framing_ != Framing::sequence) return;
+  spool_.close();
+  std::error_code ec;
+  fs::remove(frame_spool_path(dir_), ec);
+}
+
+void FrameImages::write_picture(const render::Image& image, int frame) const {
+  render::write_png((dir_ / frame_file(frame)).string(), image);  // a temporary file renamed into place
+}
+
+void FrameImages::spool(const Eigen::VectorXd& x) {
+  spool_.write(reinterpret_cast<const char*>(x.data()), static_cast<std::streamsize>(x.size() * sizeof(double)));
+  if (!spool_) throw std::runtime_error(frame_spool_path(dir_).string() + ": cannot write the file");
+}
+
+void FrameImages::add(const Eigen::VectorXd& x) {
+  if (framing_ == Framing::motion) {
+    last_image_ = renderer_.render(drawer_.frame(drawer_.snapshot(x), camera_, bounds_.lo[1]));
+    write_picture(*last_image_, frames_);
+    ++written_;
+  } else {
+    LimitSurfaceDrawer::extend_bounds(drawer_.snapshot(x), bounds_.lo, bounds_.hi);
+    spool(x);
+    last_positions_ = x;
+  }
+  ++frames_;
+}
+
+void FrameImages::repeat() {
+  if (frames_ == 0) throw std::logic_error("FrameImages::repeat: no frame to repeat");
+  if (framing_ == Framing::motion) {
+    write_picture(*last_image_, frames_);
+    ++written_;
+  } else {
+    spool(last_positions_);
+  }
+  ++frames_;
+}
+
+int FrameImages::finish() {
+  if (framing_ != Framing::sequence || !spool_.is_open()) return written_;
+  const fs::path path = frame_spool_path(dir_);
+  spool_.close();
+  if (!spool_) throw std::runtime_error(path.string() + ": cannot write the file");
+  if (frames_ > 0) {
+    const render::Camera camera = drawer_.camera(bounds_.lo, bounds_.hi);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path.string() + ": cannot open the file for reading");
+    Eigen::VectorXd positions(last_positions_.size());
+    for (int frame = 0; frame < frames_; ++frame) {
+      in.read(reinterpret_cast<char*>(positions.data()), static_cast<std::streamsize>(positions.size() * sizeof(double)));
+      if (!in) throw std::runtime_error(path.string() + ": cannot read frame " + std::to_string(frame));
+      write_picture(renderer_.render(drawer_.frame(drawer_.snapshot(positions), camera, bounds_.lo[1])), frame);
+      ++written_;
+    }
+  }
+  std::error_code ec;
+  fs::remove(path, ec);
+  if (ec) throw std::runtime_error(path.string() + ": cannot delete the file: " + ec.message());
+  return written_;
+}
+
+}  // namespace clothsim

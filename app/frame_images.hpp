@@ -1,0 +1,90 @@
+// The pictures of a dynamic run, DIR/frame_NNNN.png, with one camera for the whole run and only
+// one frame's data in memory at a time. Framing "motion" fixes the camera before the run (the
+// scene's camera, or one framing the rest shape and the scripted boundary motions, see
+// motion_framing_bounds) and writes each picture as soon as its frame is produced; framing
+// "sequence" frames the bounds of the whole simulated sequence, so it appends each frame's
+// control-net positions to the spool file DIR/.frames.bin during the run and draws every picture
+// afterwards, then deletes the spool.
+#pragma once
+
+#include "app/limit_surface_drawer.hpp"
+#include "render/image.hpp"
+#include "render/renderer.hpp"
+#include "sim/problem/problem.hpp"
+#include "sim/scene/scene.hpp"
+
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+
+namespace clothsim {
+
+// An axis-aligned box [lo, hi] [m]; empty (lo > hi) until something is added.
+struct Bounds {
+  render::Vec3f lo{1e30f, 1e30f, 1e30f};
+  render::Vec3f hi{-1e30f, -1e30f, -1e30f};
+};
+
+// Motion framing grows its box on every side by this fraction of the box's diagonal, so that a
+// cloth sagging, bulging or swinging somewhat beyond its rest shape and its moved rims stays in
+// the picture.
+inline constexpr float kMotionFramingMargin = 0.1f;
+
+// Number of equally spaced times over [0, time.end] at which motion framing samples each boundary
+// motion (the end time and every motion's start and end time are sampled as well).
+inline constexpr int kMotionFramingSamples = 64;
+
+// The box framed by motion framing: the refined surface of the rest shape (`rest`, node positions,
+// 3·#nodes [m]) together with the positions that the
+// vertices of every boundary condition of `problem` with a motion chain pass through over
+// [0, time.end], grown by kMotionFramingMargin.
+Bounds motion_framing_bounds(const LimitSurfaceDrawer& drawer, const Eigen::VectorXd& rest, const Problem& problem);
+
+// The spool file of sequence framing in the output folder `dir`: per frame, the node positions
+// (3·#nodes doubles in native byte order: x, y, z of node 0, then node 1, ...), no header. Deleted once the pictures are drawn; left behind only by a run that
+// was killed.
+std::filesystem::path frame_spool_path(const std::filesystem::path& dir);
+
+class FrameImages {
+ public:
+  // Pictures of frames drawn by `drawer` and `renderer` into `dir`. With Framing::motion,
+  // `motion_bounds` (motion_framing_bounds) sets the camera, unless the scene has one, and the
+  // ground height; it is ignored with Framing::sequence.
+  FrameImages(const LimitSurfaceDrawer& drawer, render::Renderer& renderer, Framing framing,
+              const Bounds& motion_bounds, std::filesystem::path dir);
+  // Removes the spool file if it is still there.
+  ~FrameImages();
+  FrameImages(const FrameImages&) = delete;
+  FrameImages& operator=(const FrameImages&) = delete;
+
+  // The next frame shows the state with node positions `x` (3·#nodes [m]).
+  // Motion framing: writes its picture now. Throws naming the file if it cannot be written.
+  void add(const Eigen::VectorXd& x);
+  // The next frame shows the same state as the previous one (a step longer than a frame period).
+  void repeat();
+  // Frames handed in so far.
+  int frames() const { return frames_; }
+  // Sequence framing: draws every spooled frame with one camera framing their bounds and deletes
+  // the spool file. Returns the number of pictures written by this object in all.
+  int finish();
+
+ private:
+  void write_picture(const render::Image& image, int frame) const;
+  void spool(const Eigen::VectorXd& x);
+
+  const LimitSurfaceDrawer& drawer_;
+  render::Renderer& renderer_;
+  Framing framing_;
+  std::filesystem::path dir_;
+  Bounds bounds_;  // motion: the framing box; sequence: the bounds of the frames so far
+  render::Camera camera_;  // motion framing
+  std::optional<render::Image> last_image_;  // motion framing: for a repeated frame
+  Eigen::VectorXd last_positions_;           // sequence framing: for a repeated frame
+  std::ofstream spool_;                      // sequence framing
+  int frames_ = 0;
+  int written_ = 0;
+};
+
+}  // namespace clothsim
