@@ -10,7 +10,7 @@
 #include "render/renderer.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/core/layout.hpp"
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/static/static_solve.hpp"
 

@@ -15,7 +15,8 @@ namespace clothsim::assembly_avx2 {
 
 constexpr int kLanes = 4;
 
-// Whether this processor runs the kernel (defined in corotation.cpp, compiled for the baseline).
+// Whether this build and processor run the kernel (defined in assembly_kernels.cpp, compiled for
+// the baseline instruction set).
 bool supported();
 
 // out (3 × 3, column-major) = Σ over groups [0, groups) and lanes of R K Rᵀ (R = rotations[9 e …],
@@ -25,7 +26,7 @@ bool supported();
 void sum_block(int groups, const int* element, const double* rotations, const double* stiffness, const double* rows,
                const double* tension, const int* point_offset, int points, double* out);
 
-// The same for processors without AVX2 + FMA (defined in corotation.cpp): the same sums in the
+// The same for processors without AVX2 + FMA (defined in assembly_kernels.cpp): the same sums in the
 // same order, without fused multiply-adds (so equal up to round-off, not bitwise).
 void sum_block_portable(int groups, const int* element, const double* rotations, const double* stiffness, const double* rows,
                         const double* tension, const int* point_offset, int points, double* out);

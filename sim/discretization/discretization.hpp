@@ -4,7 +4,7 @@
 // from the control DOFs to points of the surface (probes, OBJ frames, rendering, the studies'
 // sampling, point loads, and collision geometry). The integrator, the outputs and the renderer
 // adapter see only this interface; the Loop-subdivision Kirchhoff–Love shell
-// (sim/discretization/loop_shell.hpp) is one implementation, and a piecewise-flat discretisation
+// (sim/loop_shell/loop_shell.hpp) is one implementation, and a piecewise-flat discretisation
 // (linear triangles, mass-spring) is meant to be another.
 //
 // Nodes and DOFs. The discretisation has #nodes nodes (for the Loop shell: the control vertices of

@@ -1,7 +1,7 @@
 #include "sim/dynamics/simulator.hpp"
 
-#include "sim/boundary/scripted_boundary.hpp"
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/integrator/scripted_boundary.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/forces/corotated_shell.hpp"
 #include "sim/forces/damping.hpp"
 #include "sim/forces/external_loads.hpp"

@@ -10,6 +10,7 @@
 // More terms can be added before the first step (add_term), e.g. by a test.
 #pragma once
 
+#include "sim/integrator/implicit_euler.hpp"
 #include "sim/problem/problem.hpp"
 
 #include <Eigen/Core>

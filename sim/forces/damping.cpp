@@ -5,18 +5,6 @@
 
 namespace clothsim {
 
-std::vector<Eigen::Index> diagonal_offsets(const Eigen::SparseMatrix<double>& pattern) {
-  std::vector<Eigen::Index> out(static_cast<size_t>(pattern.cols()));
-  for (Eigen::Index col = 0; col < pattern.cols(); ++col) {
-    Eigen::Index at = pattern.outerIndexPtr()[col];
-    const Eigen::Index end = pattern.outerIndexPtr()[col + 1];
-    while (at < end && pattern.innerIndexPtr()[at] != col) ++at;
-    if (at == end) throw std::invalid_argument("matrix pattern: no diagonal entry in column " + std::to_string(col));
-    out[static_cast<size_t>(col)] = at;
-  }
-  return out;
-}
-
 KelvinVoigtDamping::KelvinVoigtDamping(std::unique_ptr<ForceTerm> elastic, double coefficient)
     : elastic_(std::move(elastic)), coefficient_(coefficient) {
   if (!(coefficient >= 0)) throw std::invalid_argument("Kelvin–Voigt damping: the coefficient must be >= 0 [s]");

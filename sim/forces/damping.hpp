@@ -9,6 +9,7 @@
 // Damping ratio of a mode of angular frequency ω: ζ = c_K ω / 2 + c_M / (2ω).
 #pragma once
 
+#include "sim/core/sparse_pattern.hpp"
 #include "sim/forces/force_term.hpp"
 
 #include <memory>
@@ -57,9 +58,5 @@ class MassDamping final : public ForceTerm {
   double coefficient_;
   std::vector<Eigen::Index> diagonal_;   // value offsets of the diagonal entries
 };
-
-// Value offsets of the diagonal entries of a compressed column-major matrix whose pattern holds
-// every diagonal entry (throws std::invalid_argument naming the first missing one).
-std::vector<Eigen::Index> diagonal_offsets(const Eigen::SparseMatrix<double>& pattern);
 
 }  // namespace clothsim

@@ -1,6 +1,6 @@
 #include "sim/integrator/implicit_euler.hpp"
 
-#include "sim/forces/damping.hpp"
+#include "sim/core/sparse_pattern.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>

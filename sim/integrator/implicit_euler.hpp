@@ -21,7 +21,7 @@
 // Writes no files.
 #pragma once
 
-#include "sim/boundary/scripted_boundary.hpp"
+#include "sim/integrator/scripted_boundary.hpp"
 #include "sim/discretization/discretization.hpp"
 #include "sim/forces/force_term.hpp"
 #include "sim/solver/linear_solver.hpp"

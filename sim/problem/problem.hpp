@@ -11,7 +11,6 @@
 #include "sim/shell/quadrature.hpp"
 #include "sim/forces/follower_couples.hpp"
 #include "sim/forces/point_loads.hpp"
-#include "sim/integrator/implicit_euler.hpp"
 #include "sim/solver/linear_solver.hpp"
 
 #include <Eigen/Core>

@@ -5,7 +5,7 @@
 
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/obj_io.hpp"
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/problem/validate.hpp"
 #include "sim/shell/material_presets.hpp"
 

@@ -1,5 +1,7 @@
 #include "sim/solver/cholesky_preconditioner.hpp"
 
+#include "sim/solver/blas_single.hpp"
+
 #include "sim/solver/direct_solver.hpp"
 #include "sim/solver/supernodal_kernels.hpp"
 
@@ -19,20 +21,6 @@
 #include <cmath>
 #include <cstddef>
 #include <vector>
-
-// Single-precision BLAS and LAPACK (Fortran interface; the trailing arguments are the lengths of
-// the character arguments, as gfortran passes them).
-extern "C" {
-void sgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const float* alpha,
-            const float* a, const int* lda, const float* b, const int* ldb, const float* beta, float* c, const int* ldc,
-            std::size_t, std::size_t);
-void ssyrk_(const char* uplo, const char* trans, const int* n, const int* k, const float* alpha, const float* a,
-            const int* lda, const float* beta, float* c, const int* ldc, std::size_t, std::size_t);
-void strsm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m, const int* n,
-            const float* alpha, const float* a, const int* lda, float* b, const int* ldb, std::size_t, std::size_t,
-            std::size_t, std::size_t);
-void spotrf_(const char* uplo, const int* n, float* a, const int* lda, int* info, std::size_t);
-}
 
 namespace clothsim {
 
@@ -64,11 +52,6 @@ class SingleThreadedBlas {
 };
 
 }  // namespace
-
-bool supernodal_avx2::supported() {
-  __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
-}
 
 struct CholeskyPreconditioner::Impl {
   cholmod_common common{};

@@ -9,8 +9,8 @@
 
 namespace clothsim::supernodal_avx2 {
 
-// Whether this processor can run the kernels below (AVX2, FMA, F16C) (defined in cholesky_preconditioner.cpp, which
-// is compiled for the baseline instruction set).
+// Whether this build and processor can run the kernels below (AVX2, FMA, F16C) (defined in
+// supernodal_dispatch.cpp, which is compiled for the baseline instruction set).
 bool supported();
 // Forward step: ys ← D⁻¹ ys (D the diagonal block), below ← (rows under D) · ys.
 void forward(const float* block, int height, int cols, float* ys, float* below);

@@ -1,6 +1,6 @@
 #include "sim/static/static_solve.hpp"
 
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/forces/external_loads.hpp"
 #include "sim/forces/follower_couples.hpp"
 #include "sim/forces/gravity.hpp"

@@ -2,7 +2,7 @@
 // one node to a fixed point (E = ½ k |x_n − p|², f = −k (x_n − p), K = k I on the node's block).
 // It passes the same finite-difference checks as the built-in terms, and a free plate hung from it
 // under gravity settles where the spring carries the plate's weight.
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/dynamics/simulator.hpp"
 #include "sim/forces/damping.hpp"
 #include "sim/mesh/generators.hpp"

@@ -2,7 +2,7 @@
 // random states and at hard states (strong compression, near-folded, large rotation), plus the
 // invariants each must keep: no force or energy at rest, none under rigid motion, forces that sum
 // to zero where nothing external acts, and the totals of the loads.
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/forces/corotated_shell.hpp"
 #include "sim/forces/damping.hpp"
 #include "sim/forces/external_loads.hpp"

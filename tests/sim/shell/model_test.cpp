@@ -1,7 +1,7 @@
 // The ghost layer, Loop refinement on load, and consistent loads of the shell model.
 #include "sim/mesh/generators.hpp"
 #include "sim/shell/shell_model.hpp"
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/static/static_solve.hpp"
 #include "sim/subdivision/loop.hpp"
 #include "tests/support/test_meshes.hpp"

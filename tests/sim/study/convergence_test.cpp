@@ -2,7 +2,7 @@
 // points and the limit-surface sampling operator (rigid motions, seam, agreement with the limit
 // points of solve_static), the relative RMS norm, the plate series (error falls at second order),
 // a tiny sleeve series against its reference, the method registry, and the CSV columns.
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/study/convergence.hpp"
 
 #include "sim/mesh/generators.hpp"

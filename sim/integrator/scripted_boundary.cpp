@@ -1,4 +1,4 @@
-#include "sim/boundary/scripted_boundary.hpp"
+#include "sim/integrator/scripted_boundary.hpp"
 
 namespace clothsim {
 

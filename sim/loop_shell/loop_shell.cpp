@@ -1,4 +1,4 @@
-#include "sim/discretization/loop_shell.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 
 #include "sim/core/layout.hpp"
 #include "sim/forces/corotated_shell.hpp"

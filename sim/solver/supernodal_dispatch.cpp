@@ -1,0 +1,26 @@
+// Which supernodal solve kernels this build and this processor can run (sim/solver/
+// supernodal_kernels.hpp). The AVX2 + FMA + F16C kernels are compiled only where the compiler
+// targets x86-64 (CLOTHSIM_X86_KERNELS, set in sim/solver/CMakeLists.txt); elsewhere supported()
+// is false and the portable Eigen path runs.
+#include "sim/solver/supernodal_kernels.hpp"
+
+#include <cstdlib>
+
+namespace clothsim::supernodal_avx2 {
+
+#if defined(CLOTHSIM_X86_KERNELS)
+bool supported() {
+  __builtin_cpu_init();
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+}
+#else
+bool supported() { return false; }
+// Never called (supported() is false); defined so that the dispatching code links.
+void forward(const float*, int, int, float*, float*) { std::abort(); }
+void backward(const float*, int, int, float*, const float*) { std::abort(); }
+void forward(const unsigned short*, int, int, const float*, float*, float*) { std::abort(); }
+void backward(const unsigned short*, int, int, const float*, float*, const float*) { std::abort(); }
+void to_half(const float*, const float*, const int*, int, int, unsigned short*) { std::abort(); }
+#endif
+
+}  // namespace clothsim::supernodal_avx2
