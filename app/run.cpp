@@ -10,8 +10,8 @@
 #include "render/renderer.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/core/layout.hpp"
-#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/scene/scene.hpp"
+#include "sim/setup/setup.hpp"
 #include "sim/static/static_solve.hpp"
 
 #include <nlohmann/json.hpp>
@@ -209,7 +209,7 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
     if (height > 0) settings.height = height;
     // Two passes over the files, so that only one frame is in memory at a time: the bounds of the
     // whole sequence for the camera, then the pictures.
-    std::unique_ptr<LoopShellDiscretization> surface;  // the saved mesh as a Loop control mesh
+    std::shared_ptr<Discretization> surface;  // the saved mesh as a Loop control mesh
     std::unique_ptr<LimitSurfaceDrawer> drawer;
     render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
     std::vector<Triangle> first_triangles;
@@ -217,8 +217,10 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
       const TriMesh mesh = read_obj(file.string());
       if (!drawer) {
         first_triangles = mesh.triangles;
-        surface = std::make_unique<LoopShellDiscretization>(mesh, std::vector<BoundaryCondition>{}, ShellMaterial{},
-                                                            Quadrature::one_point);
+        Problem control;  // no boundary, default material: only the surface operators are used
+        control.method = "loop_kl";
+        control.mesh = mesh;
+        surface = make_discretization(control);
         drawer = std::make_unique<LimitSurfaceDrawer>(*surface, settings, settings.width, settings.height);
       } else if (mesh.triangles != first_triangles) {
         throw std::runtime_error(file.string() + ": its triangles differ from " + files.front().string());

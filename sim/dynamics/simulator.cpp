@@ -1,31 +1,27 @@
 #include "sim/dynamics/simulator.hpp"
 
-#include "sim/integrator/scripted_boundary.hpp"
-#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/forces/corotated_shell.hpp"
 #include "sim/forces/damping.hpp"
-#include "sim/forces/external_loads.hpp"
-#include "sim/forces/follower_couples.hpp"
-#include "sim/forces/gravity.hpp"
-#include "sim/forces/point_loads.hpp"
-#include "sim/forces/surface_load.hpp"
 #include "sim/integrator/implicit_euler.hpp"
+#include "sim/integrator/scripted_boundary.hpp"
 #include "sim/problem/validate.hpp"
+#include "sim/setup/setup.hpp"
 #include "sim/solver/linear_solver.hpp"
 
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <limits>
 
 namespace clothsim {
 
 struct Simulator::Impl {
   Problem problem;
-  std::shared_ptr<const LoopShellDiscretization> discretization;
+  std::shared_ptr<const Discretization> discretization;
   Eigen::VectorXd node_mass;
   std::vector<std::unique_ptr<ForceTerm>> internal;
   std::unique_ptr<ExternalLoads> loads;
-  const CorotatedShell* shell = nullptr;
+  const CorotatedShell* shell = nullptr;  // the elastic term when it is the corotated shell (timings, strains)
   ScriptedBoundary boundary;
   LinearSolver solver;
   DynamicState state;
@@ -35,7 +31,7 @@ struct Simulator::Impl {
 
   explicit Impl(const Problem& p)
       : problem(p),
-        discretization(std::make_shared<LoopShellDiscretization>(p.mesh, p.boundary, p.material, p.quadrature)),
+        discretization(make_discretization(p)),
         boundary(*discretization, p.boundary),
         solver(p.solver, 3 * static_cast<Eigen::Index>(p.mesh.num_vertices())) {}
 
@@ -55,13 +51,13 @@ Simulator::Simulator(const Problem& problem) {
   check_problem(problem, Analysis::dynamics);
   impl_ = std::make_unique<Impl>(problem);
   Impl& m = *impl_;
-  const LoopShellDiscretization& d = *m.discretization;
+  const Discretization& d = *m.discretization;
   const int n = d.num_nodes();
   m.node_mass = d.lumped_mass(problem.material.areal_density);
 
   // Internal terms: the elastic shell (Kelvin–Voigt damped), mass damping.
   std::unique_ptr<ForceTerm> elastic = d.elastic_term(problem.corotational, problem.solver.tension_stiffening);
-  m.shell = static_cast<const CorotatedShell*>(elastic.get());
+  m.shell = dynamic_cast<const CorotatedShell*>(elastic.get());
   if (problem.damping.stiffness > 0) elastic = std::make_unique<KelvinVoigtDamping>(std::move(elastic), problem.damping.stiffness);
   m.internal.push_back(std::move(elastic));
   if (problem.damping.mass > 0)
@@ -69,14 +65,7 @@ Simulator::Simulator(const Problem& problem) {
 
   // External loads: lumped gravity (consistent with the lumped mass, so free fall is exact),
   // consistent surface loads, point loads at limit points, follower couples.
-  std::vector<std::unique_ptr<ForceTerm>> constant, varying;
-  if (problem.gravity.squaredNorm() > 0)
-    constant.push_back(make_gravity(d, problem.material.areal_density, problem.gravity, GravityModel::lumped));
-  if (problem.surface_load.squaredNorm() > 0) constant.push_back(make_surface_load(d, problem.surface_load));
-  if (problem.pressure != 0.0) constant.push_back(make_pressure(d, problem.pressure));
-  if (!problem.point_loads.empty()) constant.push_back(make_point_loads(d, problem.point_loads));
-  if (!problem.moments.empty()) varying.push_back(std::make_unique<FollowerCouples>(problem.moments));
-  m.loads = std::make_unique<ExternalLoads>(std::move(constant), std::move(varying), problem.ramp_time, 3 * n);
+  m.loads = make_external_loads(d, problem, GravityModel::lumped, problem.ramp_time);
 
   // Initial state: rest positions, rigid initial velocity field.
   m.state.x = d.rest();
@@ -112,7 +101,7 @@ StepStats Simulator::step() {
   StepStats stats = m.integrator->step(m.state);
   // The shell's rotation pass apart from the rest of the term updates (stats.csv's rotate_ms;
   // assemble_ms counts the element forces, as it always has).
-  const double rotate = m.shell->elements().total_rotate_ms() - m.shell_rotate_ms;
+  const double rotate = m.shell ? m.shell->elements().total_rotate_ms() - m.shell_rotate_ms : 0.0;
   m.shell_rotate_ms += rotate;
   stats.rotate_ms = rotate;
   stats.assemble_ms += stats.update_ms - rotate;
@@ -141,6 +130,7 @@ double Simulator::elastic_energy() const { return impl_->integrator->elastic_ene
 double Simulator::external_work() const { return impl_->integrator->external_work(); }
 double Simulator::boundary_work() const { return impl_->integrator->boundary_work(); }
 double Simulator::max_membrane_strain() const {
+  if (!impl_->shell) return std::numeric_limits<double>::quiet_NaN();
   const Eigen::MatrixX2d strains = impl_->shell->elements().membrane_principal_strains(impl_->integrator->displacement());
   return strains.size() > 0 ? strains.cwiseAbs().maxCoeff() : 0.0;
 }

@@ -61,7 +61,8 @@ class Simulator {
   double boundary_work() const;
   // Largest |principal Green–Lagrange membrane strain| of the limit surface at the element
   // barycentres in the current state [-] (CorotationalElements::membrane_principal_strains);
-  // computed on demand, a pass over the elements.
+  // computed on demand, a pass over the elements. NaN when the elastic term is not the corotated
+  // shell.
   double max_membrane_strain() const;
   // Lumped mass per node [kg] (areal density × a third of the incident area).
   const Eigen::VectorXd& vertex_mass() const;

@@ -52,7 +52,10 @@ struct InitialState {
 };
 
 struct Problem {
-  TriMesh mesh;  // control mesh, prepared by the discretisation (LoopShellDiscretization::prepare_mesh)
+  // The discretisation (sim/setup/setup.hpp: discretization_methods): "loop_kl", the Loop-
+  // subdivision Kirchhoff–Love shell.
+  std::string method = "loop_kl";
+  TriMesh mesh;  // control mesh, prepared for the method (sim/setup/setup.hpp: prepare_mesh)
   ShellMaterial material;
   std::vector<BoundaryCondition> boundary;  // dynamic: fixed components follow BoundaryCondition::motion
   // Gravity [m/s²]: lumped in a dynamic analysis, consistent in a static one (sim/forces/gravity.hpp).

@@ -5,8 +5,8 @@
 
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/obj_io.hpp"
-#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/problem/validate.hpp"
+#include "sim/setup/setup.hpp"
 #include "sim/shell/material_presets.hpp"
 
 #include <Eigen/Geometry>
@@ -795,7 +795,7 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   scene.render = read_render(r, r.find(root, "render"));
   TriMesh mesh = build_mesh(r, r.require(root, "", "mesh"), file.parent_path(), say);
   try {
-    scene.problem.mesh = LoopShellDiscretization::prepare_mesh(mesh, say);
+    scene.problem.mesh = prepare_mesh(scene.problem.method, mesh, say);
   } catch (const std::exception& e) {
     r.fail("mesh", e.what());
   }

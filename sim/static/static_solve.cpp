@@ -1,12 +1,7 @@
 #include "sim/static/static_solve.hpp"
 
-#include "sim/loop_shell/loop_shell.hpp"
-#include "sim/forces/external_loads.hpp"
-#include "sim/forces/follower_couples.hpp"
-#include "sim/forces/gravity.hpp"
-#include "sim/forces/point_loads.hpp"
-#include "sim/forces/surface_load.hpp"
 #include "sim/problem/validate.hpp"
+#include "sim/setup/setup.hpp"
 #include "sim/solver/direct_solver.hpp"
 
 #include <chrono>
@@ -24,7 +19,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 StaticResult solve_static(const Problem& problem) {
   check_problem(problem, Analysis::statics);
   const auto t0 = std::chrono::steady_clock::now();
-  auto d = std::make_shared<LoopShellDiscretization>(problem.mesh, problem.boundary, problem.material, problem.quadrature);
+  const std::shared_ptr<Discretization> d = make_discretization(problem);
   if (const std::vector<std::string> free_motions = d->unrestrained_rigid_motions(); !free_motions.empty()) {
     std::string list;
     for (const std::string& m : free_motions) list += (list.empty() ? "" : "; ") + m;
@@ -43,18 +38,10 @@ StaticResult solve_static(const Problem& problem) {
   elastic->add_matrix({1.0, 0.0}, k);
 
   // f: the loads at the rest state.
-  std::vector<std::unique_ptr<ForceTerm>> constant, varying;
-  const Eigen::Vector3d weight = problem.material.areal_density * problem.gravity;
-  if (weight.squaredNorm() > 0)
-    constant.push_back(make_gravity(*d, problem.material.areal_density, problem.gravity, GravityModel::consistent));
-  if (problem.surface_load.squaredNorm() > 0) constant.push_back(make_surface_load(*d, problem.surface_load));
-  if (problem.pressure != 0.0) constant.push_back(make_pressure(*d, problem.pressure));
-  if (!problem.point_loads.empty()) constant.push_back(make_point_loads(*d, problem.point_loads));
-  if (!problem.moments.empty()) varying.push_back(std::make_unique<FollowerCouples>(problem.moments));
-  ExternalLoads loads(std::move(constant), std::move(varying), /*ramp_time=*/0.0, n3);
-  loads.update(rest, zero, 0.0);
+  const std::unique_ptr<ExternalLoads> loads = make_external_loads(*d, problem, GravityModel::consistent, /*ramp_time=*/0.0);
+  loads->update(rest, zero, 0.0);
   Eigen::VectorXd f = zero;
-  loads.add_force(f);
+  loads->add_force(f);
 
   // The free DOFs alone: the others become unit rows and columns with zero load.
   std::vector<char> free(static_cast<size_t>(n3), 1);

@@ -3,7 +3,6 @@
 #include "sim/dynamics/simulator.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/shell/dof_map.hpp"
-#include "sim/shell/ghost_layer.hpp"
 #include "sim/study/report_format.hpp"
 
 #include <Eigen/Geometry>
