@@ -147,6 +147,8 @@ struct RunTotals {
   double rotate_ms = 0.0, assemble_ms = 0.0, solve_ms = 0.0;
   int frames = 0;
   int max_solver_iterations = 0;
+  long long contact_pairs = 0, contact_impulses = 0, impact_zones = 0, contact_unresolved = 0;
+  double contact_ms = 0.0;
 };
 
 std::string summary_json(const Scene& scene, const RunTotals& totals, double wall_seconds,
@@ -165,6 +167,12 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                    {"max_solver_iterations", totals.max_solver_iterations},
                    {"warnings", warnings},
                    {"status", status}};
+  if (scene.problem.has_contact())
+    j["contact"] = {{"pairs_tested", totals.contact_pairs},
+                    {"impulses", totals.contact_impulses},
+                    {"impact_zones", totals.impact_zones},
+                    {"unresolved_pairs", totals.contact_unresolved},
+                    {"seconds", totals.contact_ms / 1000.0}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -176,7 +184,8 @@ class Outputs {
   Outputs(const Scene& scene, const fs::path& dir, FrameImages* images)
       : scene_(scene), dir_(dir), images_(images), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
     probes_.line("step,t,name,ux,uy,uz");
-    stats_.line("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms");
+    stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms") +
+                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms" : ""));
     probes_.flush();
     stats_.flush();
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
@@ -215,11 +224,19 @@ class Outputs {
         const std::string comment = "clothsim: limit surface of scene " + scene_.name + ", frame " +
                                     std::to_string(totals.frames) + ", step " + std::to_string(step) +
                                     ", t = " + format_double(t) + " s";
-        write_obj((dir_ / "frames" / file).string(), sim.node_points(), scene_.problem.mesh.triangles, comment);
+        if (scene_.obj_level == 0) {
+          write_obj((dir_ / "frames" / file).string(), sim.node_points(), scene_.problem.mesh.triangles, comment);
+        } else {  // the surface drawn at render.refine = obj_level, with its normals
+          if (obj_surface_.num_points() == 0) obj_surface_ = sim.discretization().display(scene_.obj_level);
+          Eigen::MatrixX3d p, n;
+          obj_surface_.evaluate(sim.discretization().control_net(sim.state().x), p, n);
+          write_obj((dir_ / "frames" / file).string(), p, obj_surface_.triangles,
+                    comment + " (refined " + std::to_string(scene_.obj_level) + " times)", &n);
+        }
       }
       if (images_) {
         if (repeated) images_->repeat();
-        else images_->add(sim.state().x);
+        else images_->add(sim.state().x, sim.state().t);
       }
       repeated = true;
       ++totals.frames;
@@ -234,6 +251,11 @@ class Outputs {
           format_double(s.kinetic_energy), format_double(s.elastic_energy), format_double(s.external_work),
           format_double(s.boundary_work), std::to_string(s.factorizations), format_double(s.factor_ms)})
       row.append(1, ',').append(field);
+    if (scene_.problem.has_contact())
+      for (const std::string& field : {std::to_string(s.contact_pairs), std::to_string(s.contact_impulses),
+                                       std::to_string(s.impact_zones), std::to_string(s.contact_unresolved),
+                                       format_double(s.contact_ms)})
+        row.append(1, ',').append(field);
     stats_.line(row);
     stats_.flush();
   }
@@ -243,6 +265,7 @@ class Outputs {
   fs::path dir_;
   FrameImages* images_;
   SurfaceOperator probe_points_;  // the probes' surface points
+  SurfaceOperator obj_surface_;   // output.obj_level > 0: the refined surface of the OBJ frames
   Eigen::MatrixX3d probe_rest_;   // their rest positions [m]
   StreamFile probes_;
   StreamFile stats_;
@@ -338,6 +361,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
     try {
       drawer = std::make_unique<LimitSurfaceDrawer>(sim->discretization(), scene.render, scene.render.width,
                                                     scene.render.height);
+      drawer->set_obstacles(scene.problem.obstacles);
       renderer = std::make_unique<render::Renderer>(scene.render.width, scene.render.height);
       if (scene.render.framing == Framing::motion)
         motion_bounds = motion_framing_bounds(*drawer, sim->discretization().rest(), scene.problem);
@@ -378,6 +402,11 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
         totals.assemble_ms += s.assemble_ms;
         totals.solve_ms += s.solve_ms;
         totals.max_solver_iterations = std::max(totals.max_solver_iterations, s.solver_iterations);
+        totals.contact_pairs += s.contact_pairs;
+        totals.contact_impulses += s.contact_impulses;
+        totals.impact_zones += s.impact_zones;
+        totals.contact_unresolved += s.contact_unresolved;
+        totals.contact_ms += s.contact_ms;
         outputs->record_stats(s);
         outputs->record_state(*sim, s.step, s.t, totals);
       } catch (const SimulationError&) {

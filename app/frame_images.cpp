@@ -51,6 +51,16 @@ Bounds motion_framing_bounds(const LimitSurfaceDrawer& drawer, const Eigen::Vect
       for (double t : times) extend(b, apply_motions(bc.motion, rest_vertex, t));
     }
   }
+  for (const Obstacle& o : problem.obstacles) {
+    if (o.shape == Obstacle::Shape::plane) continue;
+    std::vector<double> times = {0.0};
+    if (!o.motion.empty())
+      for (int s = 1; s <= kMotionFramingSamples; ++s) times.push_back(end * s / kMotionFramingSamples);
+    for (double t : times) {
+      const Eigen::MatrixX3d v = mesh_at(o, t);
+      for (Eigen::Index i = 0; i < v.rows(); ++i) extend(b, v.row(i).transpose());
+    }
+  }
   float diagonal = 0.0f;
   for (std::size_t k = 0; k < 3; ++k) diagonal += (b.hi[k] - b.lo[k]) * (b.hi[k] - b.lo[k]);
   const float margin = kMotionFramingMargin * std::sqrt(diagonal);
@@ -86,20 +96,22 @@ void FrameImages::write_picture(const render::Image& image, int frame) const {
   render::write_png((dir_ / frame_file(frame)).string(), image);  // a temporary file renamed into place
 }
 
-void FrameImages::spool(const Eigen::VectorXd& x) {
+void FrameImages::spool(const Eigen::VectorXd& x, double t) {
+  spool_.write(reinterpret_cast<const char*>(&t), sizeof(double));
   spool_.write(reinterpret_cast<const char*>(x.data()), static_cast<std::streamsize>(x.size() * sizeof(double)));
   if (!spool_) throw std::runtime_error(frame_spool_path(dir_).string() + ": cannot write the file");
 }
 
-void FrameImages::add(const Eigen::VectorXd& x) {
+void FrameImages::add(const Eigen::VectorXd& x, double t) {
   if (framing_ == Framing::motion) {
-    last_image_ = renderer_.render(drawer_.frame(drawer_.snapshot(x), camera_, bounds_.lo[1]));
+    last_image_ = renderer_.render(drawer_.frame(drawer_.snapshot(x, t), camera_, bounds_.lo[1]));
     write_picture(*last_image_, frames_);
     ++written_;
   } else {
-    LimitSurfaceDrawer::extend_bounds(drawer_.snapshot(x), bounds_.lo, bounds_.hi);
-    spool(x);
+    LimitSurfaceDrawer::extend_bounds(drawer_.snapshot(x, t), bounds_.lo, bounds_.hi);
+    spool(x, t);
     last_positions_ = x;
+    last_time_ = t;
   }
   ++frames_;
 }
@@ -110,7 +122,7 @@ void FrameImages::repeat() {
     write_picture(*last_image_, frames_);
     ++written_;
   } else {
-    spool(last_positions_);
+    spool(last_positions_, last_time_);
   }
   ++frames_;
 }
@@ -126,9 +138,11 @@ int FrameImages::finish() {
     if (!in) throw std::runtime_error(path.string() + ": cannot open the file for reading");
     Eigen::VectorXd positions(last_positions_.size());
     for (int frame = 0; frame < frames_; ++frame) {
+      double t = 0.0;
+      in.read(reinterpret_cast<char*>(&t), sizeof(double));
       in.read(reinterpret_cast<char*>(positions.data()), static_cast<std::streamsize>(positions.size() * sizeof(double)));
       if (!in) throw std::runtime_error(path.string() + ": cannot read frame " + std::to_string(frame));
-      write_picture(renderer_.render(drawer_.frame(drawer_.snapshot(positions), camera, bounds_.lo[1])), frame);
+      write_picture(renderer_.render(drawer_.frame(drawer_.snapshot(positions, t), camera, bounds_.lo[1])), frame);
       ++written_;
     }
   }

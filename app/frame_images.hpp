@@ -39,11 +39,13 @@ inline constexpr int kMotionFramingSamples = 64;
 // The box framed by motion framing: the refined surface of the rest shape (`rest`, node positions,
 // 3·#nodes [m]) together with the positions that the
 // vertices of every boundary condition of `problem` with a motion chain pass through over
-// [0, time.end], grown by kMotionFramingMargin.
+// [0, time.end], and the obstacles' meshes (not planes) over the same times, grown by
+// kMotionFramingMargin.
 Bounds motion_framing_bounds(const LimitSurfaceDrawer& drawer, const Eigen::VectorXd& rest, const Problem& problem);
 
-// The spool file of sequence framing in the output folder `dir`: per frame, the node positions
-// (3·#nodes doubles in native byte order: x, y, z of node 0, then node 1, ...), no header. Deleted once the pictures are drawn; left behind only by a run that
+// The spool file of sequence framing in the output folder `dir`: per frame, its time and the node
+// positions (1 + 3·#nodes doubles in native byte order: t, then x, y, z of node 0, node 1, ...),
+// no header. Deleted once the pictures are drawn; left behind only by a run that
 // was killed.
 std::filesystem::path frame_spool_path(const std::filesystem::path& dir);
 
@@ -59,9 +61,9 @@ class FrameImages {
   FrameImages(const FrameImages&) = delete;
   FrameImages& operator=(const FrameImages&) = delete;
 
-  // The next frame shows the state with node positions `x` (3·#nodes [m]).
+  // The next frame shows the state with node positions `x` (3·#nodes [m]) at time `t` [s].
   // Motion framing: writes its picture now. Throws naming the file if it cannot be written.
-  void add(const Eigen::VectorXd& x);
+  void add(const Eigen::VectorXd& x, double t);
   // The next frame shows the same state as the previous one (a step longer than a frame period).
   void repeat();
   // Frames handed in so far.
@@ -72,7 +74,7 @@ class FrameImages {
 
  private:
   void write_picture(const render::Image& image, int frame) const;
-  void spool(const Eigen::VectorXd& x);
+  void spool(const Eigen::VectorXd& x, double t);
 
   const LimitSurfaceDrawer& drawer_;
   render::Renderer& renderer_;
@@ -82,6 +84,7 @@ class FrameImages {
   render::Camera camera_;  // motion framing
   std::optional<render::Image> last_image_;  // motion framing: for a repeated frame
   Eigen::VectorXd last_positions_;           // sequence framing: for a repeated frame
+  double last_time_ = 0.0;
   std::ofstream spool_;                      // sequence framing
   int frames_ = 0;
   int written_ = 0;

@@ -3,6 +3,7 @@
 #include "render/camera_math.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -38,7 +39,26 @@ LimitSurfaceDrawer::LimitSurfaceDrawer(const Discretization& discretization, con
   }
 }
 
-SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::VectorXd& x) const {
+void LimitSurfaceDrawer::set_obstacles(const std::vector<Obstacle>& obstacles) {
+  obstacles_.clear();
+  obstacle_triangles_.clear();
+  planes_.clear();
+  ground_plane_ = -1;
+  unsigned offset = 0;
+  for (const Obstacle& o : obstacles) {
+    if (o.shape == Obstacle::Shape::plane) {
+      planes_.push_back(o);
+      if (ground_plane_ < 0 && std::abs(o.normal.y()) > 0.999) ground_plane_ = static_cast<int>(planes_.size()) - 1;
+      continue;
+    }
+    for (const Triangle& t : o.mesh.triangles)
+      for (int v : t) obstacle_triangles_.push_back(offset + static_cast<unsigned>(v));
+    offset += static_cast<unsigned>(o.mesh.num_vertices());
+    obstacles_.push_back(o);
+  }
+}
+
+SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::VectorXd& x, double t) const {
   Eigen::MatrixX3d p, n;
   display_.evaluate(discretization_.control_net(x), p, n);
   SurfaceSnapshot s;
@@ -52,6 +72,16 @@ SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::VectorXd& x) const {
   if (settings_.wireframe) {
     s.control.resize(static_cast<std::size_t>(x.size()));
     for (Eigen::Index i = 0; i < x.size(); ++i) s.control[static_cast<std::size_t>(i)] = static_cast<float>(x(i));
+  }
+  for (const Obstacle& o : obstacles_) {
+    const Eigen::MatrixX3d v = mesh_at(o, t);
+    for (Eigen::Index i = 0; i < v.rows(); ++i)
+      for (int k = 0; k < 3; ++k) s.obstacles.push_back(static_cast<float>(v(i, k)));
+  }
+  if (ground_plane_ >= 0) {
+    Eigen::Vector3d point, normal;
+    plane_at(planes_[static_cast<std::size_t>(ground_plane_)], t, point, normal);
+    s.plane_height = static_cast<float>(point.y());
   }
   return s;
 }
@@ -99,8 +129,16 @@ render::Frame LimitSurfaceDrawer::frame(const SurfaceSnapshot& s, const render::
     lines.color = {0.15f, 0.15f, 0.15f};
     f.lines.push_back(std::move(lines));
   }
-  f.ground = settings_.ground;
-  f.ground_height = ground_height;
+  if (!s.obstacles.empty()) {
+    render::Mesh obstacles;
+    obstacles.positions = s.obstacles;  // flat-shaded primitives get smooth normals from the renderer
+    obstacles.triangles = obstacle_triangles_;
+    obstacles.color = {0.55f, 0.6f, 0.7f};
+    obstacles.back_color = {0.35f, 0.38f, 0.45f};
+    f.meshes.push_back(std::move(obstacles));
+  }
+  f.ground = settings_.ground || ground_plane_ >= 0;
+  f.ground_height = ground_plane_ >= 0 ? s.plane_height : ground_height;
   return f;
 }
 

@@ -18,6 +18,8 @@ struct SurfaceSnapshot {
   std::vector<float> positions;  // limit surface, 3 per fine vertex [m]
   std::vector<float> normals;    // unit normals, 3 per fine vertex
   std::vector<float> control;    // control mesh vertices (wireframe), 3 per vertex [m]
+  std::vector<float> obstacles;  // the obstacles' mesh vertices at the frame's time, 3 per vertex [m]
+  float plane_height = 0.0f;     // y of a horizontal plane obstacle at the frame's time [m]
 };
 
 class LimitSurfaceDrawer {
@@ -25,13 +27,17 @@ class LimitSurfaceDrawer {
   // `discretization` must outlive the drawer.
   LimitSurfaceDrawer(const Discretization& discretization, const RenderSettings& settings, int width, int height);
 
-  // `x`: node positions (3·#nodes, flat) [m].
-  SurfaceSnapshot snapshot(const Eigen::VectorXd& x) const;
-  // Grows the box [lo, hi] to hold the snapshot.
+  // Obstacles drawn with the cloth: the meshes of every non-plane obstacle (the geometry that
+  // collides), and a horizontal plane (normal ±y) as the ground; other planes are not drawn.
+  void set_obstacles(const std::vector<Obstacle>& obstacles);
+  // `x`: node positions (3·#nodes, flat) [m] at time `t` [s] (where the obstacles are).
+  SurfaceSnapshot snapshot(const Eigen::VectorXd& x, double t = 0.0) const;
+  // Grows the box [lo, hi] to hold the snapshot's cloth.
   static void extend_bounds(const SurfaceSnapshot& s, render::Vec3f& lo, render::Vec3f& hi);
   // The scene's camera, or one that frames the box [lo, hi] (viewed slightly from above).
   render::Camera camera(const render::Vec3f& lo, const render::Vec3f& hi) const;
-  // `ground_height`: y of the ground plane (when render.ground), e.g. the sequence's lowest y.
+  // `ground_height`: y of the ground plane (when render.ground), e.g. the sequence's lowest y; a
+  // horizontal plane obstacle is drawn as the ground at its own height instead.
   render::Frame frame(const SurfaceSnapshot& s, const render::Camera& camera, float ground_height) const;
 
   int fine_triangles() const { return static_cast<int>(triangles_.size() / 3); }
@@ -43,6 +49,10 @@ class LimitSurfaceDrawer {
   std::vector<unsigned> edges_;      // edges of the mesh's triangles (wireframe over the nodes)
   RenderSettings settings_;
   int width_, height_;
+  std::vector<Obstacle> obstacles_;    // drawn meshes (no planes)
+  std::vector<unsigned> obstacle_triangles_;
+  int ground_plane_ = -1;              // index into planes_ of the plane drawn as the ground
+  std::vector<Obstacle> planes_;
 };
 
 }  // namespace clothsim

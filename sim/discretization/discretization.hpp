@@ -112,6 +112,12 @@ class Discretization {
   // operator's points (J the derivative of the points' positions with respect to the node
   // positions, the transpose of the operator composed with the control net).
   virtual void add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces, Eigen::VectorXd& f) const = 0;
+  // J, the derivative of the operator's points (flat, 3·#P) with respect to the node positions
+  // (3·#nodes): 3·#P × 3·#nodes, row-major. The points are affine in x, P(x) = P(X) + J (x − X),
+  // so their velocities are J v. Its entries name free and fixed components only (dependent
+  // ones are folded in through their rule), so a change of the free components moves the points
+  // by J δv exactly once make_consistent() has derived the dependent ones.
+  virtual Eigen::SparseMatrix<double, Eigen::RowMajor> point_jacobian(const SurfaceOperator& op) const = 0;
 
   // Convenience: positions (#P × 3) [m] of an operator's points for node positions x.
   Eigen::MatrixX3d surface_positions(const SurfaceOperator& op, const Eigen::VectorXd& x) const {

@@ -1,5 +1,6 @@
 #include "sim/dynamics/simulator.hpp"
 
+#include "sim/contact/contact_stage.hpp"
 #include "sim/forces/corotated_shell.hpp"
 #include "sim/forces/damping.hpp"
 #include "sim/integrator/implicit_euler.hpp"
@@ -15,6 +16,34 @@
 
 namespace clothsim {
 
+namespace {
+
+// The contact stage as the integrator's velocity filter.
+class ContactFilter final : public VelocityFilter {
+ public:
+  ContactFilter(const Discretization& d, const Eigen::VectorXd& mass, const std::vector<char>& free,
+                const CollisionSettings& settings, const std::vector<Obstacle>& obstacles, const ContactParameters& p)
+      : stage_(d, mass, free, settings, obstacles, p) {}
+  void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, StepStats& stats) override {
+    const ContactReport r = stage_.filter(x, t, h, v);
+    stats.contact_pairs += r.pairs_tested;
+    stats.contact_impulses += r.impulses;
+    stats.impact_zones += r.impact_zones;
+    stats.contact_unresolved += r.unresolved;
+    totals_.pairs_tested += r.pairs_tested;
+    totals_.broad_ms += r.broad_ms;
+    totals_.narrow_ms += r.narrow_ms;
+    totals_.response_ms += r.response_ms;
+  }
+  const ContactStage& stage() const { return stage_; }
+
+ private:
+  ContactStage stage_;
+  ContactReport totals_;
+};
+
+}  // namespace
+
 struct Simulator::Impl {
   Problem problem;
   std::shared_ptr<const Discretization> discretization;
@@ -26,6 +55,7 @@ struct Simulator::Impl {
   LinearSolver solver;
   DynamicState state;
   std::unique_ptr<ImplicitEuler> integrator;
+  std::unique_ptr<VelocityFilter> contact;  // only when the problem has contact
   Eigen::MatrixX3d node_points_rest;
   double shell_rotate_ms = 0.0;  // rotation time of the shell's updates so far
 
@@ -44,6 +74,15 @@ struct Simulator::Impl {
     settings.extrapolated_start = problem.solver.extrapolated_start;
     integrator = std::make_unique<ImplicitEuler>(settings, *discretization, node_mass, terms, loads->empty() ? nullptr : loads.get(),
                                                  boundary, solver, state);
+    if (problem.has_contact()) {
+      if (!contact) {
+        ContactParameters parameters;
+        parameters.surface_level = problem.collision_level;
+        contact = std::make_unique<ContactFilter>(*discretization, node_mass, integrator->free_dofs(), problem.collision,
+                                                  problem.obstacles, parameters);
+      }
+      integrator->set_velocity_filter(contact.get());
+    }
   }
 };
 

@@ -173,6 +173,18 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     v_k = v_next;
   }
 
+  if (filter_) {
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      filter_->filter(x, state.t, h, v_next, stats);
+    } catch (const SimulationError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw SimulationError(step_number, t_next, e.what());
+    }
+    stats.contact_ms += ms_since(t0);
+  }
+
   // Advance; scripted components land exactly on their motion, tied ones follow their rule.
   Eigen::VectorXd x_next = x + h * v_next;
   for (size_t i = 0; i < prescribed.size(); ++i) x_next(prescribed[i]) = target(static_cast<Eigen::Index>(i));

@@ -73,6 +73,23 @@ struct StepStats {
   double external_work = 0.0;    // work of the external loads on the free components this step [J]
   double boundary_work = 0.0;    // work of the scripted and held components on the cloth this step
                                  // [J] (ImplicitEuler::boundary_work)
+  // The velocity filter's figures (contact, sim/contact/contact_stage.hpp; zero without one).
+  long long contact_pairs = 0;   // narrow-phase pairs tested
+  int contact_impulses = 0;      // impulses applied
+  int impact_zones = 0;          // zones the fail-safe moved as one
+  int contact_unresolved = 0;    // pairs still colliding at the end of the step (should be 0)
+  double contact_ms = 0.0;       // time of the filter [ms]
+};
+
+// A stage of the step after the linear solve that may change the new velocities (contact): it
+// gets the positions x at the start of the step (3·#nodes) [m], the step's start time t and
+// length h [s], and the new velocities v [m/s], and changes free components of v only (the
+// integrator then moves x to x + h v and derives the dependent components). It reports what it
+// did in `stats`. Throwing std::runtime_error stops the run with a SimulationError.
+class VelocityFilter {
+ public:
+  virtual ~VelocityFilter() = default;
+  virtual void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, StepStats& stats) = 0;
 };
 
 // A run that cannot go on: NaN, divergence or a linear solver that does not converge.
@@ -136,6 +153,11 @@ class ImplicitEuler {
   // system: a rise then measures the corotation's error alone.
   double external_work() const { return work_; }
   double boundary_work() const { return boundary_work_; }
+  // A filter of the new velocities after each solve (contact); null for none. Must outlive the
+  // integrator.
+  void set_velocity_filter(VelocityFilter* filter) { filter_ = filter; }
+  // Which DOFs are unknowns of the linear solve (3·#nodes): the ones a velocity filter may change.
+  const std::vector<char>& free_dofs() const { return free_; }
   // Displacement from the rest state (3·#nodes) [m] of the last state reached, consistent.
   const Eigen::VectorXd& displacement() const { return u_; }
 
@@ -161,6 +183,7 @@ class ImplicitEuler {
   std::vector<Eigen::Index> diagonal_;    // value offsets of its diagonal entries
   double size_ = 1.0;                     // bounding-box diagonal of the rest state [m]
   double work_ = 0.0, boundary_work_ = 0.0;
+  VelocityFilter* filter_ = nullptr;
 };
 
 }  // namespace clothsim

@@ -140,4 +140,17 @@ void LoopShellDiscretization::add_point_forces(const SurfaceOperator& op, const 
           f(dof) += it.value() * w * forces(p, c);
 }
 
+Eigen::SparseMatrix<double, Eigen::RowMajor> LoopShellDiscretization::point_jacobian(const SurfaceOperator& op) const {
+  // The operator's weights composed with each control point's combination of node components.
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index p = 0; p < op.position.rows(); ++p)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(op.position, p); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        for (const auto& [dof, w] : model_.dofs().combination(static_cast<int>(it.col()), c))
+          entries.emplace_back(static_cast<int>(3 * p + c), dof, it.value() * w);
+  Eigen::SparseMatrix<double, Eigen::RowMajor> j(3 * op.position.rows(), 3 * static_cast<Eigen::Index>(mesh_.num_vertices()));
+  j.setFromTriplets(entries.begin(), entries.end());  // sums repeated entries
+  return j;
+}
+
 }  // namespace clothsim

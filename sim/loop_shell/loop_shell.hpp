@@ -50,6 +50,7 @@ class LoopShellDiscretization final : public Discretization {
   SurfaceOperator samples(const std::vector<SurfaceSample>& samples) const override;
   SurfaceOperator display(int levels) const override;
   void add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces, Eigen::VectorXd& f) const override;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> point_jacobian(const SurfaceOperator& op) const override;
 
   // The shell model underneath (elements, ghost layer, DOF map): for the element's own tests.
   const ShellModel& model() const { return model_; }

@@ -7,6 +7,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <stdexcept>
@@ -174,15 +175,23 @@ TriMesh read_obj(const std::string& path) {
 }
 
 void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices, const std::vector<Triangle>& triangles,
-               const std::string& comment) {
+               const std::string& comment, const Eigen::MatrixX3d* normals) {
   const Eigen::Index n = vertices.rows();
+  if (normals != nullptr && normals->rows() != n)
+    throw MeshError("cannot write '" + path + "': " + std::to_string(normals->rows()) + " normals for " +
+                    std::to_string(n) + " vertices");
   for (std::size_t t = 0; t < triangles.size(); ++t)
     for (const int v : triangles[t])
       if (v < 0 || v >= n)
         throw MeshError("cannot write '" + path + "': triangle " + std::to_string(t) + " has vertex index " +
                         std::to_string(v) + " out of range (mesh has " + std::to_string(n) + " vertices)");
 
-  std::ofstream out(path, std::ios::out | std::ios::trunc);
+  const std::filesystem::path final_path(path);
+  std::string tmp_name = ".";
+  tmp_name += final_path.filename().string();
+  tmp_name += ".tmp";
+  const std::filesystem::path tmp = final_path.parent_path() / tmp_name;
+  std::ofstream out(tmp, std::ios::out | std::ios::trunc);
   if (!out) throw std::runtime_error("cannot open '" + path + "' for writing");
 
   if (!comment.empty()) {
@@ -214,10 +223,35 @@ void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices, const 
     put(vertices(v, 2));
     out << '\n';
   }
-  for (const Triangle& tri : triangles) out << "f " << tri[0] + 1 << ' ' << tri[1] + 1 << ' ' << tri[2] + 1 << '\n';
+  if (normals != nullptr)
+    for (Eigen::Index v = 0; v < n; ++v) {
+      out << "vn ";
+      put((*normals)(v, 0));
+      out << ' ';
+      put((*normals)(v, 1));
+      out << ' ';
+      put((*normals)(v, 2));
+      out << '\n';
+    }
+  for (const Triangle& tri : triangles) {
+    if (normals != nullptr)
+      out << "f " << tri[0] + 1 << "//" << tri[0] + 1 << ' ' << tri[1] + 1 << "//" << tri[1] + 1 << ' ' << tri[2] + 1
+          << "//" << tri[2] + 1 << '\n';
+    else
+      out << "f " << tri[0] + 1 << ' ' << tri[1] + 1 << ' ' << tri[2] + 1 << '\n';
+  }
 
   out.close();
-  if (!out) throw std::runtime_error("error while writing '" + path + "'");
+  std::error_code ec;
+  if (!out) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error("error while writing '" + path + "'");
+  }
+  std::filesystem::rename(tmp, final_path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error("cannot write '" + path + "': " + ec.message());
+  }
 }
 
 }  // namespace clothsim

@@ -26,9 +26,13 @@ TriMesh read_obj(const std::string& path);
 // Writes `vertices` [m] and `triangles` (0-based, written 1-based) to an OBJ file, with every
 // coordinate printed in the shortest form that reads back to the identical double. A non-empty
 // `comment` is written as a leading `# comment` line (each line of a multi-line comment gets its
-// own `#`). Throws MeshError (before touching the file) if a triangle has an out-of-range index,
-// and std::runtime_error naming the path if the file cannot be written.
+// own `#`). With `normals` (#V × 3, unit) it writes `vn` lines and faces `f a//a b//b c//c`.
+// The file is written to a temporary sibling and renamed into place, so it is whole or absent.
+// Throws MeshError (before touching the file) if a triangle has an out-of-range index or the
+// normals do not match the vertices, and std::runtime_error naming the path if the file cannot
+// be written.
 void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices,
-               const std::vector<Triangle>& triangles, const std::string& comment = "");
+               const std::vector<Triangle>& triangles, const std::string& comment = "",
+               const Eigen::MatrixX3d* normals = nullptr);
 
 }  // namespace clothsim

@@ -7,6 +7,7 @@
 
 #include "sim/mesh/mesh.hpp"
 #include "sim/boundary/boundary_condition.hpp"
+#include "sim/contact/obstacle.hpp"
 #include "sim/shell/material.hpp"
 #include "sim/shell/quadrature.hpp"
 #include "sim/forces/follower_couples.hpp"
@@ -72,6 +73,11 @@ struct Problem {
   SolverSettings solver;
   bool corotational = true;  // false: plain linear element (for comparison)
   InitialState initial;
+  // Contact (dynamic analysis only; sim/contact/): switched on by collision.self or any obstacle.
+  CollisionSettings collision;
+  std::vector<Obstacle> obstacles;
+  int collision_level = 2;  // display refinement levels of the surface that collides (the drawn one)
+  bool has_contact() const { return collision.self || !obstacles.empty(); }
 };
 
 }  // namespace clothsim

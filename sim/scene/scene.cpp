@@ -29,7 +29,8 @@ using Json = nlohmann::json;
 const char* const kAxes[3] = {"x", "y", "z"};
 
 // Top-level keys that only a dynamic scene may have.
-const char* const kDynamicOnlyKeys[] = {"time", "damping", "solver", "corotational", "initial", "output"};
+const char* const kDynamicOnlyKeys[] = {"time", "damping", "solver", "corotational", "initial", "output", "collision",
+                                        "obstacles"};
 
 const char* const kNeedsDynamic = "needs \"analysis\": \"dynamic\" (this scene is static)";
 
@@ -298,7 +299,7 @@ Json parse_text(const Reader& r, const std::string& text) {
   return j;
 }
 
-TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log) {
+TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log) {
   const std::string path = "mesh";
   if (!j.is_object()) r.fail(path, "expected an object (got " + describe(j) + ")");
   const bool has_obj = j.contains("obj");
@@ -308,7 +309,7 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
     r.fail(path, "needs \"obj\" (a file) or \"primitive\" (allowed: \"grid\", \"cylinder\")");
 
   if (has_obj) {
-    r.check_object(j, path, {"obj"});
+    r.check_object(j, path, {"obj"});  // ("rotate" and "translate" are read by build_mesh)
     const std::string key = "mesh.obj";
     const std::string name = r.string(j["obj"], key);
     if (name.empty()) r.fail(key, "expected a non-empty file path");
@@ -358,6 +359,34 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
     throw;
   } catch (const std::exception& e) {
     r.fail(path, e.what());
+  }
+  return mesh;
+}
+
+// The mesh with its optional placement: "rotate": {"axis": [x, y, z], "angle_deg": a} about the
+// origin, then "translate": [x, y, z] [m].
+TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log) {
+  if (!j.is_object()) r.fail("mesh", "expected an object (got " + describe(j) + ")");
+  Json shape = j;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  if (const Json* rot = r.find(j, "rotate")) {
+    r.check_object(*rot, "mesh.rotate", {"axis", "angle_deg"});
+    const Eigen::Vector3d axis = r.vec3(r.require(*rot, "mesh.rotate", "axis"), "mesh.rotate.axis");
+    if (!(axis.norm() > 0)) r.fail("mesh.rotate.axis", "must be a non-zero vector");
+    const double angle = r.number(r.require(*rot, "mesh.rotate", "angle_deg"), "mesh.rotate.angle_deg");
+    rotation = Eigen::AngleAxisd(angle * M_PI / 180.0, axis.normalized()).toRotationMatrix();
+    shape.erase("rotate");
+  }
+  if (const Json* tr = r.find(j, "translate")) {
+    translation = r.vec3(*tr, "mesh.translate");
+    shape.erase("translate");
+  }
+  TriMesh mesh = build_mesh_shape(r, shape, folder, log);
+  if (j.contains("rotate") || j.contains("translate")) {
+    for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
+      mesh.vertices.row(v) = (rotation * mesh.vertices.row(v).transpose() + translation).transpose();
+    log("mesh: placed (rotated, then translated)");
   }
   return mesh;
 }
@@ -632,12 +661,134 @@ InitialState read_initial(const Reader& r, const Json* j) {
   return s;
 }
 
-// "output": {"obj": bool}; returns whether OBJ frames are wanted.
-bool read_output(const Reader& r, const Json* j) {
-  if (j == nullptr) return false;
-  r.check_object(*j, "output", {"obj"});
-  const Json* obj = r.find(*j, "obj");
-  return obj != nullptr && r.boolean(*obj, "output.obj");
+// "output": {"obj": bool, "obj_level": int}: whether OBJ frames are wanted, and the refinement
+// level of the surface they hold.
+void read_output(const Reader& r, const Json* j, Scene& scene) {
+  if (j == nullptr) return;
+  r.check_object(*j, "output", {"obj", "obj_level"});
+  if (const Json* obj = r.find(*j, "obj")) scene.write_obj_frames = r.boolean(*obj, "output.obj");
+  if (const Json* level = r.find(*j, "obj_level")) {
+    scene.obj_level = r.integer_at_least(*level, "output.obj_level", 0);
+    if (scene.obj_level > 4) r.fail("output.obj_level", "must be an integer from 0 to 4 (got " + level->dump() + ")");
+  }
+}
+
+// "collision": {"self": bool, "thickness": m, "friction": -, "surface_level": int}.
+void read_collision(const Reader& r, const Json* j, Problem& problem, bool& level_given) {
+  level_given = false;
+  if (j == nullptr) return;
+  r.check_object(*j, "collision", {"self", "thickness", "friction", "surface_level"});
+  CollisionSettings& c = problem.collision;
+  if (const Json* v = r.find(*j, "self")) c.self = r.boolean(*v, "collision.self");
+  if (const Json* v = r.find(*j, "thickness")) c.thickness = r.positive(*v, "collision.thickness", "[m]");
+  if (const Json* v = r.find(*j, "friction")) c.friction = r.non_negative(*v, "collision.friction", "[-]");
+  if (const Json* v = r.find(*j, "surface_level")) {
+    problem.collision_level = r.integer_at_least(*v, "collision.surface_level", 0);
+    if (problem.collision_level > 4)
+      r.fail("collision.surface_level", "must be an integer from 0 to 4 (got " + v->dump() + ")");
+    level_given = true;
+  }
+}
+
+// "obstacles": [{"name", "primitive" | "obj", shape parameters, "friction", "motion"}].
+std::vector<Obstacle> read_obstacles(const Reader& r, const Json* j, double default_friction,
+                                     const std::filesystem::path& folder, const LogFn& log) {
+  std::vector<Obstacle> out;
+  if (j == nullptr) return out;
+  r.array(*j, "obstacles");
+  std::set<std::string> names;
+  for (std::size_t i = 0; i < j->size(); ++i) {
+    const std::string path = join_index("obstacles", i);
+    const Json& item = (*j)[i];
+    if (!item.is_object()) r.fail(path, "expected an object (got " + describe(item) + ")");
+    const bool has_obj = item.contains("obj"), has_primitive = item.contains("primitive");
+    if (has_obj && has_primitive) r.fail(path, "give either \"obj\" or \"primitive\", not both");
+    if (!has_obj && !has_primitive)
+      r.fail(path, "needs \"primitive\" (allowed: \"plane\", \"sphere\", \"capsule\", \"box\", \"cylinder\") or \"obj\" (a file)");
+    Obstacle o;
+    o.name = "obstacle" + std::to_string(i);
+    o.friction = default_friction;
+    auto key = [&](const char* k) { return join_key(path, k); };
+    std::vector<std::string> allowed = {"name", "friction", "motion"};
+    if (has_obj) {
+      o.shape = Obstacle::Shape::mesh;
+      allowed.push_back("obj");
+    } else {
+      const std::string shape =
+          r.choice(item["primitive"], key("primitive"), {"plane", "sphere", "capsule", "box", "cylinder"}, "primitive");
+      allowed.push_back("primitive");
+      if (shape == "plane") {
+        o.shape = Obstacle::Shape::plane;
+        allowed.insert(allowed.end(), {"point", "normal"});
+      } else if (shape == "sphere") {
+        o.shape = Obstacle::Shape::sphere;
+        allowed.insert(allowed.end(), {"center", "radius"});
+      } else if (shape == "box") {
+        o.shape = Obstacle::Shape::box;
+        allowed.insert(allowed.end(), {"center", "size"});
+      } else {
+        o.shape = shape == "capsule" ? Obstacle::Shape::capsule : Obstacle::Shape::cylinder;
+        allowed.insert(allowed.end(), {"from", "to", "radius"});
+      }
+    }
+    r.check_object(item, path, allowed);
+    if (const Json* v = r.find(item, "name")) {
+      o.name = r.string(*v, key("name"));
+      if (o.name.empty()) r.fail(key("name"), "must not be empty");
+    }
+    if (!names.insert(o.name).second) r.fail(key("name"), "duplicate obstacle name " + quote(o.name));
+    if (const Json* v = r.find(item, "friction")) o.friction = r.non_negative(*v, key("friction"), "[-]");
+    if (const Json* motion = r.find(item, "motion")) {
+      r.array(*motion, key("motion"));
+      for (std::size_t m = 0; m < motion->size(); ++m)
+        o.motion.push_back(read_motion(r, (*motion)[m], join_index(key("motion"), m)));
+    }
+    switch (o.shape) {
+      case Obstacle::Shape::plane:
+        o.point = r.vec3(r.require(item, path, "point"), key("point"));
+        o.normal = r.vec3(r.require(item, path, "normal"), key("normal"));
+        if (!(o.normal.norm() > 0)) r.fail(key("normal"), "must be a non-zero vector");
+        o.normal.normalize();
+        break;
+      case Obstacle::Shape::sphere:
+        o.center = r.vec3(r.require(item, path, "center"), key("center"));
+        o.radius = r.positive(r.require(item, path, "radius"), key("radius"), "[m]");
+        break;
+      case Obstacle::Shape::box:
+        o.center = r.vec3(r.require(item, path, "center"), key("center"));
+        o.size = r.vec3(r.require(item, path, "size"), key("size"));
+        if (!(o.size.minCoeff() > 0)) r.fail(key("size"), "every edge length must be > 0 [m] (got " + item["size"].dump() + ")");
+        break;
+      case Obstacle::Shape::capsule:
+      case Obstacle::Shape::cylinder:
+        o.from = r.vec3(r.require(item, path, "from"), key("from"));
+        o.to = r.vec3(r.require(item, path, "to"), key("to"));
+        o.radius = r.positive(r.require(item, path, "radius"), key("radius"), "[m]");
+        if (!((o.to - o.from).norm() > 0)) r.fail(key("to"), "must differ from \"from\"");
+        break;
+      case Obstacle::Shape::mesh: {
+        const std::string name = r.string(item["obj"], key("obj"));
+        if (name.empty()) r.fail(key("obj"), "expected a non-empty file path");
+        o.file = name;
+        const std::filesystem::path obj = folder / name;
+        try {
+          o.mesh = read_obj(obj.string());
+          check_triangles(o.mesh);
+        } catch (const std::exception& e) {
+          r.fail(key("obj"), e.what());
+        }
+        if (o.mesh.num_triangles() == 0) r.fail(key("obj"), obj.string() + ": no triangles");
+        break;
+      }
+    }
+    if (o.shape != Obstacle::Shape::plane && o.shape != Obstacle::Shape::mesh) o.mesh = tessellate(o);
+    log("obstacle " + o.name + ": " + to_string(o.shape) +
+        (o.shape == Obstacle::Shape::plane ? std::string()
+                                           : ", " + std::to_string(o.mesh.num_triangles()) + " triangles") +
+        (o.motion.empty() ? "" : ", moving"));
+    out.push_back(std::move(o));
+  }
+  return out;
 }
 
 std::vector<Probe> read_probes(const Reader& r, const Json* j, const TriMesh& mesh, const LogFn& log) {
@@ -753,7 +904,8 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   const LogFn say = log ? log : LogFn([](const std::string&) {});
   r.check_object(root, "",
                  {"name", "description", "analysis", "mesh", "material", "boundary", "loads", "probes",
-                  "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render"});
+                  "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render",
+                  "collision", "obstacles"});
 
   Scene scene;
   scene.file = file;
@@ -789,10 +941,18 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
     dyn.solver = read_solver(r, r.find(root, "solver"));
     if (const Json* c = r.find(root, "corotational")) dyn.corotational = r.boolean(*c, "corotational");
     dyn.initial = read_initial(r, r.find(root, "initial"));
-    scene.write_obj_frames = read_output(r, r.find(root, "output"));
+    read_output(r, r.find(root, "output"), scene);
   }
 
   scene.render = read_render(r, r.find(root, "render"));
+  if (dynamic) {
+    bool level_given = false;
+    read_collision(r, r.find(root, "collision"), scene.problem, level_given);
+    // Contact acts on the surface that is drawn, unless the scene says otherwise.
+    if (!level_given) scene.problem.collision_level = scene.render.refine;
+    scene.problem.obstacles =
+        read_obstacles(r, r.find(root, "obstacles"), scene.problem.collision.friction, file.parent_path(), say);
+  }
   TriMesh mesh = build_mesh(r, r.require(root, "", "mesh"), file.parent_path(), say);
   try {
     scene.problem.mesh = prepare_mesh(scene.problem.method, mesh, say);

@@ -62,6 +62,8 @@ struct Scene {
   // for dynamic scenes, time, damping, solver, corotational and initial state.
   Problem problem;
   bool write_obj_frames = false;  // dynamic scenes: "output": {"obj": true}
+  int obj_level = 0;              // "output.obj_level": OBJ frames hold the limit surface refined this
+                                  // many times (0: the limit points at the control connectivity)
   RenderSettings render;
   std::vector<Probe> probes;
 };

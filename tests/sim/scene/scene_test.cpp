@@ -553,7 +553,7 @@ TEST_F(SceneLoader, DynamicKeysRejectedInStaticScene) {
   // Unknown keys are still unknown, not "dynamic only".
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "timestep": 0.01})"),
                        expected("timestep: unknown key (allowed: name, description, analysis, mesh, material, boundary, "
-                                "loads, probes, numerics, time, damping, solver, corotational, initial, output, render)")));
+                                "loads, probes, numerics, time, damping, solver, corotational, initial, output, render, collision, obstacles)")));
 }
 
 TEST_F(SceneLoader, DynamicSettingErrors) {
@@ -593,7 +593,7 @@ TEST_F(SceneLoader, DynamicSettingErrors) {
   EXPECT_TRUE(contains(with(R"("initial": {"omega": [0, 0, 1]})"),
                        expected("initial.omega: unknown key (allowed: velocity, angular_velocity, center)")));
   EXPECT_EQ(with(R"("output": {"obj": "yes"})"), expected("output.obj: expected true or false (got \"yes\")"));
-  EXPECT_TRUE(contains(with(R"("output": {"vtk": true})"), expected("output.vtk: unknown key (allowed: obj)")));
+  EXPECT_TRUE(contains(with(R"("output": {"vtk": true})"), expected("output.vtk: unknown key (allowed: obj, obj_level)")));
   EXPECT_TRUE(contains(with(R"("output": true)"), expected("output: expected an object")));
   EXPECT_TRUE(contains(with(R"("material": {"density": 0})"),
                        expected("material: a dynamic analysis needs a positive areal density (mass) [kg/m²] (got 0.0)")));

@@ -1,0 +1,773 @@
+#include "sim/contact/contact_stage.hpp"
+
+#include "sim/contact/narrow_phase.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace clothsim {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+using contact::Box;
+
+// A narrow-phase pair. Points and triangles index the collision surface ("cloth") or the
+// obstacles' combined mesh ("obstacle"); edges likewise.
+enum class Kind : std::uint8_t {
+  cloth_point_cloth_triangle,
+  cloth_edge_cloth_edge,
+  cloth_point_obstacle_triangle,
+  obstacle_point_cloth_triangle,
+  cloth_edge_obstacle_edge,
+};
+
+struct Candidate {
+  Kind kind;
+  int a, b;  // point and triangle, or edge and edge, in the order of the kind's name
+  bool operator<(const Candidate& o) const {
+    return std::tie(kind, a, b) < std::tie(o.kind, o.a, o.b);
+  }
+  bool operator==(const Candidate& o) const { return kind == o.kind && a == o.a && b == o.b; }
+};
+
+// Geometry of one pair at one instant: up to four points on each side with coefficients
+// (relative position = Σ c_k p_k, cloth points first), a unit normal from the second primitive
+// to the first, and their distance.
+struct PairGeometry {
+  int num = 0;                        // points in use
+  std::array<int, 4> point{};         // point index (cloth or obstacle, see `obstacle`)
+  std::array<bool, 4> obstacle{};     // whether the point is an obstacle vertex
+  std::array<double, 4> coef{};       // +1 / weights on the first primitive, −weights on the second
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double distance = 0.0;
+};
+
+// A contact constraint in DOF space: the relative velocity of the pair is
+// u = Σ_dof B[dof] v[dof] + u_obstacle (3-vectors B), so an impulse λ along a unit direction e
+// changes v[dof] by W[dof] λ (B[dof]·e).
+struct Constraint {
+  std::vector<std::pair<int, Eigen::Vector3d>> b;  // (dof, B[dof])
+  Eigen::Vector3d obstacle_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double target = 0.0;    // wanted normal relative velocity [m/s]
+  double mu = 0.0;        // friction coefficient
+  double lambda = 0.0;    // accumulated normal impulse [N·s]
+  int obstacle = -1;      // obstacle involved, or −1
+};
+
+// Union–find over nodes for impact zones.
+struct Zones {
+  std::vector<int> parent;
+  explicit Zones(int n) : parent(static_cast<size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int i) {
+    while (parent[static_cast<size_t>(i)] != i) {
+      parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+      i = parent[static_cast<size_t>(i)];
+    }
+    return i;
+  }
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
+  }
+};
+
+// A rigid map p ↦ R p + c.
+struct RigidMap {
+  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  Eigen::Vector3d operator()(const Eigen::Vector3d& p) const { return r * p + c; }
+};
+
+// The rigid map that best takes points `from` to `to` (Kabsch, equal weights); a translation
+// for fewer than three points.
+RigidMap fit_rigid(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to) {
+  RigidMap m;
+  if (from.empty()) return m;
+  Eigen::Vector3d cf = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < from.size(); ++i) {
+    cf += from[i];
+    ct += to[i];
+  }
+  cf /= static_cast<double>(from.size());
+  ct /= static_cast<double>(from.size());
+  if (from.size() >= 3) {
+    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < from.size(); ++i) h += (from[i] - cf) * (to[i] - ct).transpose();
+    Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
+    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
+    m.r = svd.matrixV() * d * svd.matrixU().transpose();
+  }
+  m.c = ct - m.r * cf;
+  return m;
+}
+
+}  // namespace
+
+struct ContactStage::Impl {
+  const Discretization& d;
+  CollisionSettings settings;
+  ContactParameters params;
+  std::vector<Obstacle> obstacles;
+
+  // The collision surface.
+  SurfaceOperator surface;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;  // 3·#P × 3·#nodes
+  Eigen::MatrixX3d rest_points;                          // #P × 3
+  std::vector<std::array<int, 2>> edges;                 // surface edges (points)
+  std::vector<std::array<int, 3>> triangle_edges;        // per surface triangle
+  Eigen::VectorXd inverse_mass;                          // per DOF: 1/m for free DOFs, else 0
+  std::vector<char> free;
+  Eigen::VectorXd node_mass;
+
+  // The obstacles' meshes, combined (planes are apart).
+  std::vector<Triangle> obstacle_triangles;
+  std::vector<std::array<int, 2>> obstacle_edges;
+  std::vector<std::array<int, 3>> obstacle_triangle_edges;
+  std::vector<int> obstacle_of_vertex;  // obstacle index per combined vertex
+  std::vector<int> vertex_offset;       // per obstacle: first combined vertex
+  std::vector<int> planes;              // obstacle indices of planes
+
+  contact::BroadPhase self_broad, obstacle_broad;
+  // Pairs of surface triangles (i < j) nearer than 2·thickness to each other at rest, sorted:
+  // never contacts (the shell's own stiffness keeps them apart; colliding them would hold a fine
+  // surface's neighbours apart).
+  std::vector<std::pair<int, int>> near_at_rest;
+
+  // Scratch for building constraints: slot per DOF (−1 when unused).
+  std::vector<int> slot;
+
+  // Per step.
+  Eigen::MatrixX3d p0, p1;          // surface points at the start and end of the step
+  Eigen::MatrixX3d o0, o1;          // obstacle vertices at t and t + h
+  double h = 0.0;
+
+  Impl(const Discretization& disc, const Eigen::VectorXd& mass, const std::vector<char>& free_dofs,
+       const CollisionSettings& s, std::vector<Obstacle> obs, const ContactParameters& p)
+      : d(disc), settings(s), params(p), obstacles(std::move(obs)), free(free_dofs), node_mass(mass) {
+    if (!(settings.thickness > 0)) throw std::invalid_argument("collision: the thickness must be > 0 [m]");
+    if (!(settings.friction >= 0)) throw std::invalid_argument("collision: the friction coefficient must be >= 0");
+    if (params.surface_level < 0) throw std::invalid_argument("collision: the surface level must be >= 0");
+    surface = d.display(params.surface_level);
+    jacobian = d.point_jacobian(surface);
+    rest_points = d.surface_positions(surface, d.rest());
+    const int n3 = 3 * d.num_nodes();
+    if (static_cast<int>(free.size()) != n3 || node_mass.size() != d.num_nodes())
+      throw std::invalid_argument("ContactStage: the masses and the free-DOF mask must cover every node");
+    inverse_mass = Eigen::VectorXd::Zero(n3);
+    for (int i = 0; i < n3; ++i)
+      if (free[static_cast<size_t>(i)] && node_mass(i / 3) > 0) inverse_mass(i) = 1.0 / node_mass(i / 3);
+    slot.assign(static_cast<size_t>(n3), -1);
+    build_edges(surface.triangles, edges, triangle_edges);
+    if (settings.self) find_near_at_rest();
+
+    std::vector<Triangle> tris;
+    for (size_t k = 0; k < obstacles.size(); ++k) {
+      const Obstacle& o = obstacles[k];
+      vertex_offset.push_back(static_cast<int>(obstacle_of_vertex.size()));
+      if (o.shape == Obstacle::Shape::plane) {
+        planes.push_back(static_cast<int>(k));
+        continue;
+      }
+      const int offset = vertex_offset.back();
+      for (int v = 0; v < o.mesh.num_vertices(); ++v) obstacle_of_vertex.push_back(static_cast<int>(k));
+      for (const Triangle& t : o.mesh.triangles) obstacle_triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+    }
+    build_edges(obstacle_triangles, obstacle_edges, obstacle_triangle_edges);
+  }
+
+  static void build_edges(const std::vector<Triangle>& tris, std::vector<std::array<int, 2>>& out,
+                          std::vector<std::array<int, 3>>& per_triangle) {
+    std::map<std::pair<int, int>, int> ids;
+    per_triangle.resize(tris.size());
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const auto key = std::minmax(tris[t][static_cast<size_t>(k)], tris[t][static_cast<size_t>((k + 1) % 3)]);
+        auto [it, inserted] = ids.emplace(key, static_cast<int>(out.size()));
+        if (inserted) out.push_back({key.first, key.second});
+        per_triangle[t][static_cast<size_t>(k)] = it->second;
+      }
+  }
+
+  // Distance between two triangles of the collision surface in `p` [m].
+  double triangle_distance(const Eigen::MatrixX3d& p, const std::array<int, 3>& a, const std::array<int, 3>& b) const {
+    double dist = std::numeric_limits<double>::infinity();
+    auto pt = [&](int i) -> Eigen::Vector3d { return p.row(i).transpose(); };
+    for (int k = 0; k < 3; ++k) {
+      dist = std::min(dist, contact::point_triangle(pt(a[static_cast<size_t>(k)]), pt(b[0]), pt(b[1]), pt(b[2])).distance);
+      dist = std::min(dist, contact::point_triangle(pt(b[static_cast<size_t>(k)]), pt(a[0]), pt(a[1]), pt(a[2])).distance);
+      for (int l = 0; l < 3; ++l)
+        dist = std::min(dist, contact::edge_edge(pt(a[static_cast<size_t>(k)]), pt(a[static_cast<size_t>((k + 1) % 3)]),
+                                           pt(b[static_cast<size_t>(l)]), pt(b[static_cast<size_t>((l + 1) % 3)]))
+                            .distance);
+    }
+    return dist;
+  }
+
+  void find_near_at_rest() {
+    const double near = 2.0 * settings.thickness;
+    std::vector<Box> boxes(surface.triangles.size());
+    for (size_t t = 0; t < surface.triangles.size(); ++t) boxes[t] = swept_box(rest_points, rest_points, surface.triangles[t], near);
+    for (const auto& [i, j] : self_broad.self_pairs(boxes)) {
+      const auto& ta = surface.triangles[static_cast<size_t>(i)];
+      const auto& tb = surface.triangles[static_cast<size_t>(j)];
+      if (shares_vertex(ta, tb) || triangle_distance(rest_points, ta, tb) < near) near_at_rest.emplace_back(i, j);
+    }
+  }
+
+  // --- Positions -------------------------------------------------------------------------------
+  Eigen::Vector3d cloth(const Eigen::MatrixX3d& p, int i) const { return p.row(i).transpose(); }
+
+  void update_end_points(const Eigen::VectorXd& v) {
+    const Eigen::VectorXd pv = jacobian * v;  // surface point velocities, flat
+    p1 = p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
+  }
+
+  // --- Broad phase -----------------------------------------------------------------------------
+  static Box swept_box(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b, const std::array<int, 3>& t, double grow) {
+    Box box{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
+            Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity())};
+    for (int v : t) {
+      box.lo = box.lo.cwiseMin(a.row(v).transpose()).cwiseMin(b.row(v).transpose());
+      box.hi = box.hi.cwiseMax(a.row(v).transpose()).cwiseMax(b.row(v).transpose());
+    }
+    box.lo.array() -= grow;
+    box.hi.array() += grow;
+    return box;
+  }
+
+  static bool shares_vertex(const std::array<int, 3>& a, const std::array<int, 3>& b) {
+    for (int x : a)
+      for (int y : b)
+        if (x == y) return true;
+    return false;
+  }
+
+  static bool overlap(const Box& a, const Box& b) {
+    return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
+  }
+  static Box grown(Box b, double g) {
+    b.lo.array() -= g;
+    b.hi.array() += g;
+    return b;
+  }
+
+  std::vector<Candidate> candidates(ContactReport& report) {
+    const auto t0 = Clock::now();
+    std::vector<Candidate> out;
+    const double grow = settings.thickness;
+    // Swept boxes: triangles grown by the thickness (for the broad phase), and exact ones of the
+    // triangles, points (grown by the thickness) and edges (grown by half of it) to cull the
+    // pairs a triangle pair stands for.
+    std::vector<Box> cloth_boxes(surface.triangles.size()), tight(surface.triangles.size());
+    for (size_t t = 0; t < surface.triangles.size(); ++t) {
+      tight[t] = swept_box(p0, p1, surface.triangles[t], 0.0);
+      cloth_boxes[t] = grown(tight[t], grow);
+    }
+    std::vector<Box> point_box(static_cast<size_t>(p0.rows())), edge_box(edges.size());
+    for (Eigen::Index p = 0; p < p0.rows(); ++p)
+      point_box[static_cast<size_t>(p)] = grown(swept_box(p0, p1, {static_cast<int>(p), static_cast<int>(p), static_cast<int>(p)}, 0.0), grow);
+    for (size_t e = 0; e < edges.size(); ++e)
+      edge_box[e] = grown(swept_box(p0, p1, {edges[e][0], edges[e][1], edges[e][1]}, 0.0), 0.5 * grow);
+    if (settings.self) {
+      const std::vector<std::pair<int, int>> pairs = self_broad.self_pairs(cloth_boxes);
+      auto skip = near_at_rest.begin();  // both sorted: one merge pass
+      for (const auto& [i, j] : pairs) {
+        while (skip != near_at_rest.end() && *skip < std::make_pair(i, j)) ++skip;
+        if (skip != near_at_rest.end() && *skip == std::make_pair(i, j)) continue;
+        const auto& ta = surface.triangles[static_cast<size_t>(i)];
+        const auto& tb = surface.triangles[static_cast<size_t>(j)];
+        for (int v : ta)
+          if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(j)])) out.push_back({Kind::cloth_point_cloth_triangle, v, j});
+        for (int v : tb)
+          if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(i)])) out.push_back({Kind::cloth_point_cloth_triangle, v, i});
+        for (int ea : triangle_edges[static_cast<size_t>(i)])
+          for (int eb : triangle_edges[static_cast<size_t>(j)])
+            if (overlap(edge_box[static_cast<size_t>(ea)], edge_box[static_cast<size_t>(eb)]))
+              out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb)});
+      }
+    }
+    if (!obstacle_triangles.empty()) {
+      std::vector<Box> obstacle_boxes(obstacle_triangles.size());
+      for (size_t t = 0; t < obstacle_triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obstacle_triangles[t], 0.0);
+      std::vector<Box> obstacle_edge_box(obstacle_edges.size());
+      for (size_t e = 0; e < obstacle_edges.size(); ++e)
+        obstacle_edge_box[e] = grown(swept_box(o0, o1, {obstacle_edges[e][0], obstacle_edges[e][1], obstacle_edges[e][1]}, 0.0), 0.5 * grow);
+      for (const auto& [i, j] : obstacle_broad.pairs(cloth_boxes, obstacle_boxes)) {
+        for (int v : surface.triangles[static_cast<size_t>(i)])
+          if (overlap(point_box[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
+            out.push_back({Kind::cloth_point_obstacle_triangle, v, j});
+        for (int v : obstacle_triangles[static_cast<size_t>(j)]) {
+          const Box ob = grown(swept_box(o0, o1, {v, v, v}, 0.0), grow);
+          if (overlap(ob, tight[static_cast<size_t>(i)])) out.push_back({Kind::obstacle_point_cloth_triangle, v, i});
+        }
+        for (int ea : triangle_edges[static_cast<size_t>(i)])
+          for (int eb : obstacle_triangle_edges[static_cast<size_t>(j)])
+            if (overlap(edge_box[static_cast<size_t>(ea)], obstacle_edge_box[static_cast<size_t>(eb)]))
+              out.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    // A point of one triangle against the other, or edges sharing a point (both triangles near
+    // other, far-apart triangles that are both near it): not a pair.
+    out.erase(std::remove_if(out.begin(), out.end(),
+                             [&](const Candidate& c) {
+                               if (c.kind == Kind::cloth_point_cloth_triangle) {
+                                 const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+                                 return t[0] == c.a || t[1] == c.a || t[2] == c.a;
+                               }
+                               if (c.kind == Kind::cloth_edge_cloth_edge) {
+                                 const auto& ea = edges[static_cast<size_t>(c.a)];
+                                 const auto& eb = edges[static_cast<size_t>(c.b)];
+                                 return ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1];
+                               }
+                               return false;
+                             }),
+              out.end());
+    report.broad_ms += ms_since(t0);
+    return out;
+  }
+
+  // --- Pair geometry ---------------------------------------------------------------------------
+  // The four points of a pair at the start (τ = 0) or end (τ = 1) of the step.
+  std::array<Eigen::Vector3d, 4> corners(const Candidate& c, bool end) const {
+    const Eigen::MatrixX3d& p = end ? p1 : p0;
+    const Eigen::MatrixX3d& o = end ? o1 : o0;
+    auto cp = [&](int i) -> Eigen::Vector3d { return p.row(i).transpose(); };
+    auto op = [&](int i) -> Eigen::Vector3d { return o.row(i).transpose(); };
+    switch (c.kind) {
+      case Kind::cloth_point_cloth_triangle: {
+        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+        return {cp(c.a), cp(t[0]), cp(t[1]), cp(t[2])};
+      }
+      case Kind::cloth_edge_cloth_edge: {
+        const auto& ea = edges[static_cast<size_t>(c.a)];
+        const auto& eb = edges[static_cast<size_t>(c.b)];
+        return {cp(ea[0]), cp(ea[1]), cp(eb[0]), cp(eb[1])};
+      }
+      case Kind::cloth_point_obstacle_triangle: {
+        const auto& t = obstacle_triangles[static_cast<size_t>(c.b)];
+        return {cp(c.a), op(t[0]), op(t[1]), op(t[2])};
+      }
+      case Kind::obstacle_point_cloth_triangle: {
+        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+        return {op(c.a), cp(t[0]), cp(t[1]), cp(t[2])};
+      }
+      case Kind::cloth_edge_obstacle_edge: {
+        const auto& ea = edges[static_cast<size_t>(c.a)];
+        const auto& eb = obstacle_edges[static_cast<size_t>(c.b)];
+        return {cp(ea[0]), cp(ea[1]), op(eb[0]), op(eb[1])};
+      }
+    }
+    return {};
+  }
+
+  bool is_point_triangle(Kind k) const { return k != Kind::cloth_edge_cloth_edge && k != Kind::cloth_edge_obstacle_edge; }
+
+  // The pair's points, coefficients, normal and distance for the four corners `x`.
+  PairGeometry geometry(const Candidate& c, const std::array<Eigen::Vector3d, 4>& x) const {
+    PairGeometry g;
+    g.num = 4;
+    std::array<int, 4> ids{};
+    std::array<bool, 4> obstacle{};
+    switch (c.kind) {
+      case Kind::cloth_point_cloth_triangle: {
+        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+        ids = {c.a, t[0], t[1], t[2]};
+        break;
+      }
+      case Kind::cloth_edge_cloth_edge: {
+        const auto& ea = edges[static_cast<size_t>(c.a)];
+        const auto& eb = edges[static_cast<size_t>(c.b)];
+        ids = {ea[0], ea[1], eb[0], eb[1]};
+        break;
+      }
+      case Kind::cloth_point_obstacle_triangle: {
+        const auto& t = obstacle_triangles[static_cast<size_t>(c.b)];
+        ids = {c.a, t[0], t[1], t[2]};
+        obstacle = {false, true, true, true};
+        break;
+      }
+      case Kind::obstacle_point_cloth_triangle: {
+        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+        ids = {c.a, t[0], t[1], t[2]};
+        obstacle = {true, false, false, false};
+        break;
+      }
+      case Kind::cloth_edge_obstacle_edge: {
+        const auto& ea = edges[static_cast<size_t>(c.a)];
+        const auto& eb = obstacle_edges[static_cast<size_t>(c.b)];
+        ids = {ea[0], ea[1], eb[0], eb[1]};
+        obstacle = {false, false, true, true};
+        break;
+      }
+    }
+    g.point = ids;
+    g.obstacle = obstacle;
+    if (is_point_triangle(c.kind)) {
+      const contact::PointTriangleProximity q = contact::point_triangle(x[0], x[1], x[2], x[3]);
+      g.coef = {1.0, -q.weights[0], -q.weights[1], -q.weights[2]};
+      g.normal = q.normal;
+      g.distance = q.distance;
+    } else {
+      const contact::EdgeEdgeProximity q = contact::edge_edge(x[0], x[1], x[2], x[3]);
+      g.coef = {1.0 - q.s, q.s, -(1.0 - q.t), -q.t};
+      g.normal = q.normal;
+      g.distance = q.distance;
+    }
+    return g;
+  }
+
+  int obstacle_of(const PairGeometry& g) const {
+    for (int k = 0; k < g.num; ++k)
+      if (g.obstacle[static_cast<size_t>(k)]) return obstacle_of_vertex[static_cast<size_t>(g.point[static_cast<size_t>(k)])];
+    return -1;
+  }
+
+  // The constraint of a pair's geometry: B over the DOFs through J, the obstacle side's velocity.
+  Constraint constraint(const PairGeometry& g) {
+    Constraint c;
+    c.normal = g.normal;
+    c.obstacle = obstacle_of(g);
+    c.mu = c.obstacle >= 0 ? obstacles[static_cast<size_t>(c.obstacle)].friction : settings.friction;
+    for (int k = 0; k < g.num; ++k) {
+      const double coef = g.coef[static_cast<size_t>(k)];
+      const int p = g.point[static_cast<size_t>(k)];
+      if (coef == 0.0) continue;
+      if (g.obstacle[static_cast<size_t>(k)]) {
+        c.obstacle_velocity += coef * (o1.row(p) - o0.row(p)).transpose() / h;
+        continue;
+      }
+      for (int comp = 0; comp < 3; ++comp)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(jacobian, 3 * p + comp); it; ++it) {
+          const int dof = static_cast<int>(it.col());
+          int& s = slot[static_cast<size_t>(dof)];
+          if (s < 0) {
+            s = static_cast<int>(c.b.size());
+            c.b.emplace_back(dof, Eigen::Vector3d::Zero());
+          }
+          c.b[static_cast<size_t>(s)].second[comp] += coef * it.value();
+        }
+    }
+    for (const auto& entry : c.b) slot[static_cast<size_t>(entry.first)] = -1;
+    return c;
+  }
+
+  Eigen::Vector3d relative_velocity(const Constraint& c, const Eigen::VectorXd& v) const {
+    Eigen::Vector3d u = c.obstacle_velocity;
+    for (const auto& [dof, b] : c.b) u += b * v(dof);
+    return u;
+  }
+  double inverse_mass_along(const Constraint& c, const Eigen::Vector3d& e) const {
+    double k = 0.0;
+    for (const auto& [dof, b] : c.b) k += inverse_mass(dof) * b.dot(e) * b.dot(e);
+    return k;
+  }
+  void apply(const Constraint& c, const Eigen::Vector3d& e, double lambda, Eigen::VectorXd& v) const {
+    for (const auto& [dof, b] : c.b) v(dof) += inverse_mass(dof) * lambda * b.dot(e);
+  }
+
+
+  // --- Obstacle motion over the step ------------------------------------------------------------
+  // The rigid map that takes the obstacle from its place at time t to its place at t + h.
+  RigidMap step_map(const Obstacle& o, double t) const {
+    auto pose = [&](double time) {
+      RigidMap m;
+      m.c = obstacle_point(o, Eigen::Vector3d::Zero(), time);
+      for (int k = 0; k < 3; ++k) m.r.col(k) = obstacle_point(o, Eigen::Vector3d::Unit(k), time) - m.c;
+      return m;
+    };
+    const RigidMap a = pose(t), b = pose(t + h);
+    RigidMap m;
+    m.r = b.r * a.r.transpose();
+    m.c = b.c - m.r * a.c;
+    return m;
+  }
+
+  // --- Narrow phase ------------------------------------------------------------------------------
+  // A pair to respond to: its constraint, and the distance it had where it was found.
+  struct Found {
+    Constraint constraint;
+    double distance = 0.0;
+  };
+
+  // Planes: every surface point against every plane, at the start of the step (or, for
+  // `end`, at its end: a plane that only translates has a distance linear in τ, so a point in
+  // front at both ends is in front throughout).
+  void plane_pairs(double t, bool end, double limit, std::vector<Found>& out, ContactReport& report) {
+    for (int k : planes) {
+      const Obstacle& o = obstacles[static_cast<size_t>(k)];
+      Eigen::Vector3d q0, n0, q1, n1;
+      plane_at(o, t, q0, n0);
+      plane_at(o, t + h, q1, n1);
+      const RigidMap move = step_map(o, t);
+      for (Eigen::Index p = 0; p < p0.rows(); ++p) {
+        ++report.pairs_tested;
+        const Eigen::Vector3d a = p0.row(p).transpose();
+        const double d0 = n0.dot(a - q0);
+        const double dist = end ? n1.dot(p1.row(p).transpose() - q1) : d0;
+        if (dist >= limit) continue;
+        PairGeometry g;
+        g.num = 1;
+        g.point[0] = static_cast<int>(p);
+        g.coef[0] = 1.0;
+        g.normal = n0;
+        g.distance = d0;
+        Found f{constraint(g), d0};
+        f.constraint.obstacle = k;
+        f.constraint.mu = o.friction;
+        f.constraint.obstacle_velocity = -(move(a) - a) / h;  // minus the plane's velocity at the point
+        out.push_back(std::move(f));
+      }
+    }
+  }
+
+  // Pairs closer than the thickness at the start of the step.
+  std::vector<Found> proximity(const std::vector<Candidate>& cands, double t, ContactReport& report) {
+    const auto t0 = Clock::now();
+    std::vector<Found> out;
+    for (const Candidate& c : cands) {
+      ++report.pairs_tested;
+      const PairGeometry g = geometry(c, corners(c, false));
+      if (g.distance < settings.thickness) out.push_back({constraint(g), g.distance});
+    }
+    plane_pairs(t, /*end=*/false, settings.thickness, out, report);
+    report.narrow_ms += ms_since(t0);
+    return out;
+  }
+
+  // Pairs whose distance may fall below the minimum separation during the step (CCD), with their
+  // geometry at the (conservative) time of impact.
+  std::vector<Found> collisions(const std::vector<Candidate>& cands, double t, ContactReport& report) {
+    const auto t0 = Clock::now();
+    const double eta = params.min_separation_ratio * settings.thickness;
+    std::vector<Found> out;
+    for (const Candidate& c : cands) {
+      ++report.pairs_tested;
+      const std::array<Eigen::Vector3d, 4> a = corners(c, false), b = corners(c, true);
+      const contact::CcdResult r = is_point_triangle(c.kind) ? contact::point_triangle_ccd(a, b, eta)
+                                                             : contact::edge_edge_ccd(a, b, eta);
+      if (!r.hit) continue;
+      std::array<Eigen::Vector3d, 4> x;
+      for (size_t k = 0; k < 4; ++k) x[k] = a[k] + r.toi * (b[k] - a[k]);
+      const PairGeometry g = geometry(c, x);
+      out.push_back({constraint(g), g.distance});
+    }
+    plane_pairs(t, /*end=*/true, eta, out, report);
+    report.narrow_ms += ms_since(t0);
+    return out;
+  }
+
+  // --- Response ----------------------------------------------------------------------------------
+  // Gauss–Seidel over the constraints: normal impulses (accumulated, ≥ 0) up to each target,
+  // then Coulomb friction bounded by μ times the normal impulse.
+  void respond(std::vector<Found>& found, int sweeps, bool friction, Eigen::VectorXd& v, ContactReport& report) {
+    const auto t0 = Clock::now();
+    for (int sweep = 0; sweep < sweeps; ++sweep) {
+      bool changed = false;
+      for (Found& f : found) {
+        Constraint& c = f.constraint;
+        const double k = inverse_mass_along(c, c.normal);
+        if (!(k > 0)) continue;  // nothing on the cloth side can move
+        const double vn = c.normal.dot(relative_velocity(c, v));
+        const double lambda = std::max(0.0, c.lambda + (c.target - vn) / k);
+        if (lambda != c.lambda) {
+          apply(c, c.normal, lambda - c.lambda, v);
+          c.lambda = lambda;
+          ++report.impulses;
+          changed = true;
+        }
+      }
+      if (!changed) break;
+    }
+    if (friction)
+      for (Found& f : found) {
+        Constraint& c = f.constraint;
+        if (!(c.lambda > 0) || !(c.mu > 0)) continue;
+        const Eigen::Vector3d u = relative_velocity(c, v);
+        const Eigen::Vector3d ut = u - c.normal.dot(u) * c.normal;
+        const double speed = ut.norm();
+        if (!(speed > 0)) continue;
+        const Eigen::Vector3d e = ut / speed;
+        const double k = inverse_mass_along(c, e);
+        if (!(k > 0)) continue;
+        apply(c, e, -std::min(speed / k, c.mu * c.lambda), v);  // never reverses the sliding
+        ++report.impulses;
+      }
+    report.response_ms += ms_since(t0);
+  }
+
+  // --- Fail-safe: impact zones -------------------------------------------------------------------
+  void move_zones(Zones& zones, const std::vector<int>& zone_obstacle, const Eigen::VectorXd& x, double t,
+                  Eigen::VectorXd& v, ContactReport& report) {
+    const auto t0 = Clock::now();
+    const int n = d.num_nodes();
+    // Members of each zone: the nodes marked by a colliding pair, grouped by their root.
+    std::map<int, std::vector<int>> members;
+    for (int i = 0; i < n; ++i)
+      if (zone_obstacle[static_cast<size_t>(i)] != -2) members[zones.find(i)].push_back(i);
+    report.impact_zones = 0;
+    for (auto& [root, nodes] : members) {
+      (void)root;
+      ++report.impact_zones;
+      auto pos = [&](int i) -> Eigen::Vector3d { return x.segment<3>(3 * i); };
+      auto node_free = [&](int i) { return free[static_cast<size_t>(3 * i)] && free[static_cast<size_t>(3 * i + 1)] && free[static_cast<size_t>(3 * i + 2)]; };
+      int obstacle = -1;  // the zone's obstacle (the highest index when it touches several)
+      for (int i : nodes) obstacle = std::max(obstacle, zone_obstacle[static_cast<size_t>(i)]);
+      std::vector<Eigen::Vector3d> from, to;
+      for (int i : nodes)
+        if (!node_free(i)) {
+          from.push_back(pos(i));
+          to.push_back(pos(i) + h * v.segment<3>(3 * i));
+        }
+      RigidMap map;
+      bool have_map = false;
+      if (obstacle >= 0) {
+        map = step_map(obstacles[static_cast<size_t>(obstacle)], t);
+        have_map = true;
+      } else if (!from.empty()) {
+        map = fit_rigid(from, to);
+        have_map = true;
+      }
+      if (have_map) {
+        for (int i : nodes)
+          for (int k = 0; k < 3; ++k)
+            if (free[static_cast<size_t>(3 * i + k)]) v(3 * i + k) = (map(pos(i))[k] - pos(i)[k]) / h;
+        continue;
+      }
+      // A free zone: the rigid velocity field with the zone's linear and angular momentum.
+      double mass = 0.0;
+      Eigen::Vector3d momentum = Eigen::Vector3d::Zero(), centre = Eigen::Vector3d::Zero();
+      for (int i : nodes) {
+        const double m = node_mass(i);
+        mass += m;
+        momentum += m * v.segment<3>(3 * i);
+        centre += m * pos(i);
+      }
+      if (!(mass > 0)) continue;
+      centre /= mass;
+      Eigen::Vector3d angular = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();
+      for (int i : nodes) {
+        const double m = node_mass(i);
+        const Eigen::Vector3d r = pos(i) - centre;
+        angular += m * r.cross(v.segment<3>(3 * i));
+        inertia += m * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
+      }
+      const Eigen::Vector3d omega = inertia.completeOrthogonalDecomposition().solve(angular);
+      const Eigen::Vector3d velocity = momentum / mass;
+      for (int i : nodes) v.segment<3>(3 * i) = velocity + omega.cross(pos(i) - centre);
+    }
+    report.response_ms += ms_since(t0);
+  }
+
+  // --- The stage ---------------------------------------------------------------------------------
+  ContactReport filter(const Eigen::VectorXd& x, double t, double step, Eigen::VectorXd& v) {
+    ContactReport report;
+    h = step;
+    auto t0 = Clock::now();
+    p0 = d.surface_positions(surface, x);
+    if (!obstacle_of_vertex.empty()) {
+      o0.resize(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
+      o1.resize(o0.rows(), 3);
+      for (size_t k = 0; k < obstacles.size(); ++k) {
+        const Obstacle& o = obstacles[k];
+        if (o.shape == Obstacle::Shape::plane) continue;
+        o0.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t);
+        o1.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t + h);
+      }
+    }
+    update_end_points(v);
+    report.narrow_ms += ms_since(t0);
+
+    // Proximity at the start of the step.
+    std::vector<Candidate> cands = candidates(report);
+    std::vector<Found> near = proximity(cands, t, report);
+    report.proximity_pairs = static_cast<int>(near.size());
+    for (Found& f : near) f.constraint.target = params.repulsion_ratio * (settings.thickness - f.distance) / h;
+    respond(near, params.proximity_sweeps, /*friction=*/true, v, report);
+
+    // Continuous collision detection and inelastic impulses.
+    const double eta = params.min_separation_ratio * settings.thickness;
+    std::vector<Found> hits;
+    for (int pass = 0; pass < params.ccd_passes; ++pass) {
+      t0 = Clock::now();
+      update_end_points(v);
+      report.narrow_ms += ms_since(t0);
+      cands = candidates(report);
+      hits = collisions(cands, t, report);
+      report.ccd_collisions += static_cast<int>(hits.size());
+      if (hits.empty()) return report;
+      for (Found& f : hits) f.constraint.target = std::max(0.0, (eta - f.distance) / h);
+      respond(hits, 1, /*friction=*/false, v, report);
+    }
+
+    // Fail-safe: impact zones, merged until the step is free.
+    const int n = d.num_nodes();
+    Zones zones(n);
+    std::vector<int> zone_obstacle(static_cast<size_t>(n), -2);  // −2: in no zone; −1: a cloth zone
+    for (int round = 0; round < params.zone_rounds; ++round) {
+      t0 = Clock::now();
+      update_end_points(v);
+      report.narrow_ms += ms_since(t0);
+      if (round > 0) {
+        cands = candidates(report);
+        hits = collisions(cands, t, report);
+        if (hits.empty()) return report;
+      }
+      for (const Found& f : hits) {
+        const Constraint& c = f.constraint;
+        int first = -1;
+        for (const auto& entry : c.b) {
+          const int node = entry.first / 3;
+          if (first < 0) first = node;
+          zones.unite(first, node);
+        }
+        if (first < 0) continue;
+        for (const auto& entry : c.b) {
+          const int node = entry.first / 3;
+          int& z = zone_obstacle[static_cast<size_t>(node)];
+          if (z == -2) z = -1;
+          if (c.obstacle >= 0) z = std::max(z, c.obstacle);
+        }
+      }
+      move_zones(zones, zone_obstacle, x, t, v, report);
+    }
+    update_end_points(v);
+    report.unresolved = static_cast<int>(collisions(candidates(report), t, report).size());
+    return report;
+  }
+};
+
+ContactStage::ContactStage(const Discretization& discretization, const Eigen::VectorXd& node_mass,
+                           const std::vector<char>& free, const CollisionSettings& settings, std::vector<Obstacle> obstacles,
+                           const ContactParameters& parameters)
+    : impl_(std::make_unique<Impl>(discretization, node_mass, free, settings, std::move(obstacles), parameters)) {}
+
+ContactStage::~ContactStage() = default;
+
+ContactReport ContactStage::filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v) {
+  return impl_->filter(x, t, h, v);
+}
+
+const SurfaceOperator& ContactStage::surface() const { return impl_->surface; }
+const std::vector<Obstacle>& ContactStage::obstacles() const { return impl_->obstacles; }
+
+}  // namespace clothsim

@@ -1,0 +1,87 @@
+// Contact as one stage of the time step: a velocity filter applied after the linear solve
+// (Bridson, Fedkiw & Anderson 2002, as the paper's §6 does), so the system matrix keeps its
+// fixed pattern. It takes the step's start positions x and new velocities v (end positions
+// x + h v) and changes the free components of v so that the step ends with the cloth's collision
+// surface separated from itself and from the obstacles (docs/contact.md has the algorithm, its
+// parameters and what is guaranteed).
+//
+// The collision surface. Contact acts on the surface that is drawn: the discretisation's display
+// operator at `surface_level` (the Loop shell's limit surface refined that many times, its points
+// an affine function of the nodes, P = P(X) + J (x − X)). A constraint between surface points is a
+// constraint on the node velocities through Jᵀ, with the nodes' lumped masses: impulses on the
+// surface spread over the control nodes that carry it, and nothing is assumed about which node
+// is "nearest".
+//
+// Per step:
+//  1. broad phase: the boxes of the surface triangles swept over the step and grown by the
+//     thickness, against each other (self-collision) and against the obstacles' swept triangles
+//     (Embree, sim/contact/broad_phase.hpp); candidate point–triangle and edge–edge pairs;
+//  2. proximity: pairs closer than the thickness at the start of the step get inelastic impulses
+//     that stop their approach, a repulsion of at most 10 % of the overlap per step, and Coulomb
+//     friction bounded by μ times the normal impulse;
+//  3. continuous collision detection over the step (additive CCD, sim/contact/narrow_phase.hpp)
+//     down to a minimum separation of 10 % of the thickness; colliding pairs get inelastic
+//     impulses; repeated up to `ccd_passes` times;
+//  4. fail-safe: pairs still colliding are merged into impact zones (nodes that share a pair or a
+//     node) that move as one affine map for the step — a rigid motion fitted to the zone's
+//     momentum, or the obstacle's or the prescribed nodes' motion when the zone holds them — which
+//     cannot create an intersection inside the zone; repeated until the step is free.
+// A scene without self-collision and obstacles builds no ContactStage at all.
+#pragma once
+
+#include "sim/contact/broad_phase.hpp"
+#include "sim/contact/obstacle.hpp"
+#include "sim/discretization/discretization.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include <memory>
+#include <vector>
+
+namespace clothsim {
+
+// What one step's contact stage did.
+struct ContactReport {
+  long long pairs_tested = 0;  // narrow-phase pairs (point–triangle and edge–edge) examined
+  int proximity_pairs = 0;     // pairs within the thickness at the start of the step
+  int impulses = 0;            // impulses applied (proximity, friction and CCD)
+  int ccd_collisions = 0;      // colliding pairs found by CCD, summed over the passes
+  int impact_zones = 0;        // zones the fail-safe made move as one (0 when not needed)
+  int unresolved = 0;          // pairs still colliding when the fail-safe gave up (should be 0)
+  double broad_ms = 0.0, narrow_ms = 0.0, response_ms = 0.0;  // split of the stage's time [ms]
+  double total_ms() const { return broad_ms + narrow_ms + response_ms; }
+};
+
+struct ContactParameters {
+  int surface_level = 2;             // display refinement levels of the collision surface
+  double min_separation_ratio = 0.1; // CCD keeps this fraction of the thickness
+  double repulsion_ratio = 0.1;      // proximity pushes apart at most this fraction of the overlap per step
+  int proximity_sweeps = 4;          // Gauss–Seidel sweeps over the proximity pairs
+  int ccd_passes = 8;                // CCD and impulse passes before the fail-safe
+  int zone_rounds = 100;             // fail-safe rounds before giving up (reported as unresolved)
+};
+
+class ContactStage {
+ public:
+  // `discretization` and the masses must outlive the stage. `node_mass`: lumped mass per node
+  // [kg]; `free`: per DOF (3·#nodes), whether it is an unknown (others are prescribed or derived
+  // and are never changed). Throws std::invalid_argument for bad settings.
+  ContactStage(const Discretization& discretization, const Eigen::VectorXd& node_mass, const std::vector<char>& free,
+               const CollisionSettings& settings, std::vector<Obstacle> obstacles, const ContactParameters& parameters);
+  ~ContactStage();
+
+  // Filters the step from time t to t + h: x the start positions (3·#nodes) [m], v the new
+  // velocities [m/s], changed in place on free components only.
+  ContactReport filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v);
+
+  // The collision surface (the display operator at surface_level) and its points at x.
+  const SurfaceOperator& surface() const;
+  const std::vector<Obstacle>& obstacles() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clothsim
