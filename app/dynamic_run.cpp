@@ -148,7 +148,7 @@ struct RunTotals {
   int frames = 0;
   int max_solver_iterations = 0;
   long long contact_pairs = 0, contact_impulses = 0, impact_zones = 0, contact_unresolved = 0;
-  double contact_ms = 0.0;
+  double contact_ms = 0.0, contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;
 };
 
 std::string summary_json(const Scene& scene, const RunTotals& totals, double wall_seconds,
@@ -172,7 +172,10 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                     {"impulses", totals.contact_impulses},
                     {"impact_zones", totals.impact_zones},
                     {"unresolved_pairs", totals.contact_unresolved},
-                    {"seconds", totals.contact_ms / 1000.0}};
+                    {"seconds", totals.contact_ms / 1000.0},
+                    {"broad_phase_seconds", totals.contact_broad_ms / 1000.0},
+                    {"narrow_phase_seconds", totals.contact_narrow_ms / 1000.0},
+                    {"response_seconds", totals.contact_response_ms / 1000.0}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -407,6 +410,9 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
         totals.impact_zones += s.impact_zones;
         totals.contact_unresolved += s.contact_unresolved;
         totals.contact_ms += s.contact_ms;
+        totals.contact_broad_ms += s.contact_broad_ms;
+        totals.contact_narrow_ms += s.contact_narrow_ms;
+        totals.contact_response_ms += s.contact_response_ms;
         outputs->record_stats(s);
         outputs->record_state(*sim, s.step, s.t, totals);
       } catch (const SimulationError&) {

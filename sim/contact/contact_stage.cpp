@@ -132,6 +132,7 @@ struct ContactStage::Impl {
   Eigen::MatrixX3d rest_points;                          // #P × 3
   std::vector<std::array<int, 2>> edges;                 // surface edges (points)
   std::vector<std::array<int, 3>> triangle_edges;        // per surface triangle
+  std::vector<std::vector<int>> owned_points, owned_edges;  // per surface triangle (build_ownership)
   Eigen::VectorXd inverse_mass;                          // per DOF: 1/m for free DOFs, else 0
   std::vector<char> free;
   Eigen::VectorXd node_mass;
@@ -140,15 +141,20 @@ struct ContactStage::Impl {
   std::vector<Triangle> obstacle_triangles;
   std::vector<std::array<int, 2>> obstacle_edges;
   std::vector<std::array<int, 3>> obstacle_triangle_edges;
+  std::vector<std::vector<int>> obstacle_owned_points, obstacle_owned_edges;
   std::vector<int> obstacle_of_vertex;  // obstacle index per combined vertex
   std::vector<int> vertex_offset;       // per obstacle: first combined vertex
   std::vector<int> planes;              // obstacle indices of planes
 
   contact::BroadPhase self_broad, obstacle_broad;
-  // Pairs of surface triangles (i < j) nearer than 2·thickness to each other at rest, sorted:
-  // never contacts (the shell's own stiffness keeps them apart; colliding them would hold a fine
-  // surface's neighbours apart).
-  std::vector<std::pair<int, int>> near_at_rest;
+  // Patches: the fine triangles over one surface triangle of the discretisation (display
+  // triangle i lies over surface triangle i / 4^levels). The broad phase works on patches; two
+  // patches whose surface triangles share a vertex never collide with each other (the surface
+  // over them is one smooth piece of a few elements, which the shell's bending keeps from folding
+  // onto itself; colliding them would hold the fine surface's neighbours apart).
+  int fine_per_patch = 1;
+  int num_patches = 0;
+  std::vector<std::array<int, 3>> patch_vertices;  // the surface triangle's vertices
 
   // Scratch for building constraints: slot per DOF (−1 when unused).
   std::vector<int> slot;
@@ -175,7 +181,11 @@ struct ContactStage::Impl {
       if (free[static_cast<size_t>(i)] && node_mass(i / 3) > 0) inverse_mass(i) = 1.0 / node_mass(i / 3);
     slot.assign(static_cast<size_t>(n3), -1);
     build_edges(surface.triangles, edges, triangle_edges);
-    if (settings.self) find_near_at_rest();
+    build_ownership(surface.triangles, static_cast<int>(rest_points.rows()), triangle_edges, static_cast<int>(edges.size()),
+                    owned_points, owned_edges);
+    fine_per_patch = 1 << (2 * surface.levels);
+    num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
+    for (int t = 0; t < num_patches; ++t) patch_vertices.push_back(d.control_triangles()[static_cast<size_t>(t)]);
 
     std::vector<Triangle> tris;
     for (size_t k = 0; k < obstacles.size(); ++k) {
@@ -190,6 +200,29 @@ struct ContactStage::Impl {
       for (const Triangle& t : o.mesh.triangles) obstacle_triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
     }
     build_edges(obstacle_triangles, obstacle_edges, obstacle_triangle_edges);
+    build_ownership(obstacle_triangles, static_cast<int>(obstacle_of_vertex.size()), obstacle_triangle_edges,
+                    static_cast<int>(obstacle_edges.size()), obstacle_owned_points, obstacle_owned_edges);
+  }
+
+  // Each point and each edge is owned by the first triangle that has it, so that expanding
+  // triangle pairs into point–triangle and edge–edge pairs makes each pair once.
+  static void build_ownership(const std::vector<Triangle>& tris, int num_points, const std::vector<std::array<int, 3>>& tri_edges,
+                              int num_edges, std::vector<std::vector<int>>& points, std::vector<std::vector<int>>& owned_edges) {
+    std::vector<char> point_taken(static_cast<size_t>(num_points), 0), edge_taken(static_cast<size_t>(num_edges), 0);
+    points.assign(tris.size(), {});
+    owned_edges.assign(tris.size(), {});
+    for (size_t t = 0; t < tris.size(); ++t)
+      for (int k = 0; k < 3; ++k) {
+        const int v = tris[t][static_cast<size_t>(k)], e = tri_edges[t][static_cast<size_t>(k)];
+        if (!point_taken[static_cast<size_t>(v)]) {
+          point_taken[static_cast<size_t>(v)] = 1;
+          points[t].push_back(v);
+        }
+        if (!edge_taken[static_cast<size_t>(e)]) {
+          edge_taken[static_cast<size_t>(e)] = 1;
+          owned_edges[t].push_back(e);
+        }
+      }
   }
 
   static void build_edges(const std::vector<Triangle>& tris, std::vector<std::array<int, 2>>& out,
@@ -203,32 +236,6 @@ struct ContactStage::Impl {
         if (inserted) out.push_back({key.first, key.second});
         per_triangle[t][static_cast<size_t>(k)] = it->second;
       }
-  }
-
-  // Distance between two triangles of the collision surface in `p` [m].
-  double triangle_distance(const Eigen::MatrixX3d& p, const std::array<int, 3>& a, const std::array<int, 3>& b) const {
-    double dist = std::numeric_limits<double>::infinity();
-    auto pt = [&](int i) -> Eigen::Vector3d { return p.row(i).transpose(); };
-    for (int k = 0; k < 3; ++k) {
-      dist = std::min(dist, contact::point_triangle(pt(a[static_cast<size_t>(k)]), pt(b[0]), pt(b[1]), pt(b[2])).distance);
-      dist = std::min(dist, contact::point_triangle(pt(b[static_cast<size_t>(k)]), pt(a[0]), pt(a[1]), pt(a[2])).distance);
-      for (int l = 0; l < 3; ++l)
-        dist = std::min(dist, contact::edge_edge(pt(a[static_cast<size_t>(k)]), pt(a[static_cast<size_t>((k + 1) % 3)]),
-                                           pt(b[static_cast<size_t>(l)]), pt(b[static_cast<size_t>((l + 1) % 3)]))
-                            .distance);
-    }
-    return dist;
-  }
-
-  void find_near_at_rest() {
-    const double near = 2.0 * settings.thickness;
-    std::vector<Box> boxes(surface.triangles.size());
-    for (size_t t = 0; t < surface.triangles.size(); ++t) boxes[t] = swept_box(rest_points, rest_points, surface.triangles[t], near);
-    for (const auto& [i, j] : self_broad.self_pairs(boxes)) {
-      const auto& ta = surface.triangles[static_cast<size_t>(i)];
-      const auto& tb = surface.triangles[static_cast<size_t>(j)];
-      if (shares_vertex(ta, tb) || triangle_distance(rest_points, ta, tb) < near) near_at_rest.emplace_back(i, j);
-    }
   }
 
   // --- Positions -------------------------------------------------------------------------------
@@ -275,72 +282,90 @@ struct ContactStage::Impl {
     // Swept boxes: triangles grown by the thickness (for the broad phase), and exact ones of the
     // triangles, points (grown by the thickness) and edges (grown by half of it) to cull the
     // pairs a triangle pair stands for.
-    std::vector<Box> cloth_boxes(surface.triangles.size()), tight(surface.triangles.size());
-    for (size_t t = 0; t < surface.triangles.size(); ++t) {
-      tight[t] = swept_box(p0, p1, surface.triangles[t], 0.0);
-      cloth_boxes[t] = grown(tight[t], grow);
+    // Swept boxes of the points first (p0 and p1 per point), then of triangles and edges as unions.
+    const Eigen::Index np = p0.rows();
+    std::vector<Box> point_box(static_cast<size_t>(np));
+    for (Eigen::Index p = 0; p < np; ++p) {
+      Box& b = point_box[static_cast<size_t>(p)];
+      for (int k = 0; k < 3; ++k) {
+        b.lo[k] = std::min(p0(p, k), p1(p, k));
+        b.hi[k] = std::max(p0(p, k), p1(p, k));
+      }
     }
-    std::vector<Box> point_box(static_cast<size_t>(p0.rows())), edge_box(edges.size());
-    for (Eigen::Index p = 0; p < p0.rows(); ++p)
-      point_box[static_cast<size_t>(p)] = grown(swept_box(p0, p1, {static_cast<int>(p), static_cast<int>(p), static_cast<int>(p)}, 0.0), grow);
+    auto unite = [](Box a, const Box& b) {
+      a.lo = a.lo.cwiseMin(b.lo);
+      a.hi = a.hi.cwiseMax(b.hi);
+      return a;
+    };
+    std::vector<Box> tight(surface.triangles.size());
+    for (size_t t = 0; t < surface.triangles.size(); ++t) {
+      const auto& tri = surface.triangles[t];
+      tight[t] = unite(unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]),
+                       point_box[static_cast<size_t>(tri[2])]);
+    }
+    std::vector<Box> patch_box(static_cast<size_t>(num_patches));
+    for (int q = 0; q < num_patches; ++q) {
+      Box b = tight[static_cast<size_t>(q * fine_per_patch)];
+      for (int k = 1; k < fine_per_patch; ++k) b = unite(b, tight[static_cast<size_t>(q * fine_per_patch + k)]);
+      patch_box[static_cast<size_t>(q)] = grown(b, 0.5 * grow);
+    }
+    std::vector<Box> edge_box(edges.size());
     for (size_t e = 0; e < edges.size(); ++e)
-      edge_box[e] = grown(swept_box(p0, p1, {edges[e][0], edges[e][1], edges[e][1]}, 0.0), 0.5 * grow);
+      edge_box[e] = grown(unite(point_box[static_cast<size_t>(edges[e][0])], point_box[static_cast<size_t>(edges[e][1])]), 0.5 * grow);
+    for (Box& b : point_box) b = grown(b, grow);
+    // Two fine triangles of the cloth from patches that share no vertex: their owned points
+    // against the other triangle, and their owned edges against each other.
+    auto add_triangle_pair = [&](int i, int j) {
+      for (int v : owned_points[static_cast<size_t>(i)])
+        if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(j)])) out.push_back({Kind::cloth_point_cloth_triangle, v, j});
+      for (int v : owned_points[static_cast<size_t>(j)])
+        if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(i)])) out.push_back({Kind::cloth_point_cloth_triangle, v, i});
+      for (int ea : owned_edges[static_cast<size_t>(i)])
+        for (int eb : owned_edges[static_cast<size_t>(j)])
+          if (overlap(edge_box[static_cast<size_t>(ea)], edge_box[static_cast<size_t>(eb)]))
+            out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb)});
+    };
     if (settings.self) {
-      const std::vector<std::pair<int, int>> pairs = self_broad.self_pairs(cloth_boxes);
-      auto skip = near_at_rest.begin();  // both sorted: one merge pass
-      for (const auto& [i, j] : pairs) {
-        while (skip != near_at_rest.end() && *skip < std::make_pair(i, j)) ++skip;
-        if (skip != near_at_rest.end() && *skip == std::make_pair(i, j)) continue;
-        const auto& ta = surface.triangles[static_cast<size_t>(i)];
-        const auto& tb = surface.triangles[static_cast<size_t>(j)];
-        for (int v : ta)
-          if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(j)])) out.push_back({Kind::cloth_point_cloth_triangle, v, j});
-        for (int v : tb)
-          if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(i)])) out.push_back({Kind::cloth_point_cloth_triangle, v, i});
-        for (int ea : triangle_edges[static_cast<size_t>(i)])
-          for (int eb : triangle_edges[static_cast<size_t>(j)])
-            if (overlap(edge_box[static_cast<size_t>(ea)], edge_box[static_cast<size_t>(eb)]))
-              out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb)});
+      for (const auto& [qa, qb] : self_broad.self_pairs(patch_box)) {
+        if (shares_vertex(patch_vertices[static_cast<size_t>(qa)], patch_vertices[static_cast<size_t>(qb)])) continue;
+        for (int a = qa * fine_per_patch; a < (qa + 1) * fine_per_patch; ++a) {
+          const Box ga = grown(tight[static_cast<size_t>(a)], grow);
+          for (int b = qb * fine_per_patch; b < (qb + 1) * fine_per_patch; ++b)
+            if (overlap(ga, tight[static_cast<size_t>(b)])) add_triangle_pair(a, b);
+        }
       }
     }
     if (!obstacle_triangles.empty()) {
       std::vector<Box> obstacle_boxes(obstacle_triangles.size());
       for (size_t t = 0; t < obstacle_triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obstacle_triangles[t], 0.0);
-      std::vector<Box> obstacle_edge_box(obstacle_edges.size());
-      for (size_t e = 0; e < obstacle_edges.size(); ++e)
-        obstacle_edge_box[e] = grown(swept_box(o0, o1, {obstacle_edges[e][0], obstacle_edges[e][1], obstacle_edges[e][1]}, 0.0), 0.5 * grow);
-      for (const auto& [i, j] : obstacle_broad.pairs(cloth_boxes, obstacle_boxes)) {
-        for (int v : surface.triangles[static_cast<size_t>(i)])
-          if (overlap(point_box[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
-            out.push_back({Kind::cloth_point_obstacle_triangle, v, j});
-        for (int v : obstacle_triangles[static_cast<size_t>(j)]) {
-          const Box ob = grown(swept_box(o0, o1, {v, v, v}, 0.0), grow);
-          if (overlap(ob, tight[static_cast<size_t>(i)])) out.push_back({Kind::obstacle_point_cloth_triangle, v, i});
-        }
-        for (int ea : triangle_edges[static_cast<size_t>(i)])
-          for (int eb : obstacle_triangle_edges[static_cast<size_t>(j)])
-            if (overlap(edge_box[static_cast<size_t>(ea)], obstacle_edge_box[static_cast<size_t>(eb)]))
-              out.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
+      std::vector<Box> obstacle_point_box(obstacle_of_vertex.size());
+      for (size_t v = 0; v < obstacle_point_box.size(); ++v) {
+        const int i = static_cast<int>(v);
+        obstacle_point_box[v] = swept_box(o0, o1, {i, i, i}, 0.0);
       }
+      std::vector<Box> obstacle_edge_box(obstacle_edges.size());
+      for (size_t e = 0; e < obstacle_edges.size(); ++e) {
+        const Box& a = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][0])];
+        const Box& b = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][1])];
+        obstacle_edge_box[e] = grown(Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}, 0.5 * grow);
+      }
+      for (const auto& [q, j] : obstacle_broad.pairs(patch_box, obstacle_boxes))
+        for (int i = q * fine_per_patch; i < (q + 1) * fine_per_patch; ++i) {
+          if (!overlap(grown(tight[static_cast<size_t>(i)], grow), obstacle_boxes[static_cast<size_t>(j)])) continue;
+          for (int v : owned_points[static_cast<size_t>(i)])
+            if (overlap(point_box[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
+              out.push_back({Kind::cloth_point_obstacle_triangle, v, j});
+          for (int v : obstacle_owned_points[static_cast<size_t>(j)])
+            if (overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), tight[static_cast<size_t>(i)]))
+              out.push_back({Kind::obstacle_point_cloth_triangle, v, i});
+          for (int ea : owned_edges[static_cast<size_t>(i)])
+            for (int eb : obstacle_owned_edges[static_cast<size_t>(j)])
+              if (overlap(edge_box[static_cast<size_t>(ea)], obstacle_edge_box[static_cast<size_t>(eb)]))
+                out.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
+        }
     }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    // A point of one triangle against the other, or edges sharing a point (both triangles near
-    // other, far-apart triangles that are both near it): not a pair.
-    out.erase(std::remove_if(out.begin(), out.end(),
-                             [&](const Candidate& c) {
-                               if (c.kind == Kind::cloth_point_cloth_triangle) {
-                                 const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-                                 return t[0] == c.a || t[1] == c.a || t[2] == c.a;
-                               }
-                               if (c.kind == Kind::cloth_edge_cloth_edge) {
-                                 const auto& ea = edges[static_cast<size_t>(c.a)];
-                                 const auto& eb = edges[static_cast<size_t>(c.b)];
-                                 return ea[0] == eb[0] || ea[0] == eb[1] || ea[1] == eb[0] || ea[1] == eb[1];
-                               }
-                               return false;
-                             }),
-              out.end());
+    // Every pair is made once (ownership) in an order fixed by the sorted broad-phase pairs, so
+    // the list is deterministic without sorting.
     report.broad_ms += ms_since(t0);
     return out;
   }

@@ -30,16 +30,13 @@ class ContactFilter final : public VelocityFilter {
     stats.contact_impulses += r.impulses;
     stats.impact_zones += r.impact_zones;
     stats.contact_unresolved += r.unresolved;
-    totals_.pairs_tested += r.pairs_tested;
-    totals_.broad_ms += r.broad_ms;
-    totals_.narrow_ms += r.narrow_ms;
-    totals_.response_ms += r.response_ms;
+    stats.contact_broad_ms += r.broad_ms;
+    stats.contact_narrow_ms += r.narrow_ms;
+    stats.contact_response_ms += r.response_ms;
   }
-  const ContactStage& stage() const { return stage_; }
 
  private:
   ContactStage stage_;
-  ContactReport totals_;
 };
 
 }  // namespace

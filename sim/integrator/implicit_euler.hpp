@@ -78,7 +78,8 @@ struct StepStats {
   int contact_impulses = 0;      // impulses applied
   int impact_zones = 0;          // zones the fail-safe moved as one
   int contact_unresolved = 0;    // pairs still colliding at the end of the step (should be 0)
-  double contact_ms = 0.0;       // time of the filter [ms]
+  double contact_ms = 0.0;       // time of the filter [ms], of it:
+  double contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;  // its phases
 };
 
 // A stage of the step after the linear solve that may change the new velocities (contact): it
