@@ -30,6 +30,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <functional>
 #include <atomic>
 #include <climits>
 #include <cmath>
@@ -148,6 +149,7 @@ struct CollideContext {
   const Box* boxes1;
   unsigned n0, n1;
   bool self;
+  const std::function<bool(int, int)>* keep;  // optional filter (self pairs, i < j)
   PairBuffers* buffers;
   std::atomic<bool> bad_index{false};
   std::atomic<bool> out_of_memory{false};
@@ -169,7 +171,7 @@ void on_collide(void* user, RTCCollision* collisions, unsigned num_collisions) {
         if (i == j) continue;
         if (i > j) std::swap(i, j);
       }
-      if (overlap(ctx->boxes0[i], ctx->boxes1[j]))
+      if (overlap(ctx->boxes0[i], ctx->boxes1[j]) && (ctx->keep == nullptr || (*ctx->keep)(static_cast<int>(i), static_cast<int>(j))))
         out.emplace_back(static_cast<int>(i), static_cast<int>(j));
     }
   } catch (...) {  // std::bad_alloc from a buffer; must not escape into Embree
@@ -279,7 +281,7 @@ struct BroadPhase::Impl {
   }
 
   std::vector<Pair> collide(const BoxScene& s0, const BoxScene& s1, const std::vector<Box>& b0,
-                            const std::vector<Box>& b1, bool self) {
+                            const std::vector<Box>& b1, bool self, const std::function<bool(int, int)>* keep = nullptr) {
     for (std::vector<Pair>& buffer : buffers) buffer.clear();
     CollideContext ctx;
     ctx.boxes0 = b0.data();
@@ -287,6 +289,7 @@ struct BroadPhase::Impl {
     ctx.n0 = static_cast<unsigned>(b0.size());
     ctx.n1 = static_cast<unsigned>(b1.size());
     ctx.self = self;
+    ctx.keep = keep;
     ctx.buffers = &buffers;
     rtcCollide(s0.scene, s1.scene, on_collide, &ctx);
     check("rtcCollide");
@@ -294,15 +297,19 @@ struct BroadPhase::Impl {
     if (ctx.bad_index.load())
       throw std::runtime_error("BroadPhase: rtcCollide reported a primitive index out of range");
 
-    std::size_t total = 0;
-    for (const std::vector<Pair>& buffer : buffers) total += buffer.size();
-    std::vector<Pair> result;
-    result.reserve(total);
+    // Counting sort by the first index (O(n + k)), then each bucket by the second: the result
+    // depends only on the set of pairs, not on the buffers' order.
+    std::vector<std::size_t> start(static_cast<std::size_t>(ctx.n0) + 1, 0);
     for (const std::vector<Pair>& buffer : buffers)
-      result.insert(result.end(), buffer.begin(), buffer.end());
-    // Pairs are totally ordered and equal ones are identical, so the parallel sort gives the
-    // same result as a sequential one, independent of the buffers' order.
-    tbb::parallel_sort(result.begin(), result.end());
+      for (const Pair& p : buffer) ++start[static_cast<std::size_t>(p.first) + 1];
+    for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+    std::vector<Pair> result(start.back());
+    std::vector<std::size_t> next(start.begin(), start.end() - 1);
+    for (const std::vector<Pair>& buffer : buffers)
+      for (const Pair& p : buffer) result[next[static_cast<std::size_t>(p.first)]++] = p;
+    for (std::size_t i = 0; i + 1 < start.size(); ++i)
+      if (start[i + 1] - start[i] > 1)
+        std::sort(result.begin() + static_cast<std::ptrdiff_t>(start[i]), result.begin() + static_cast<std::ptrdiff_t>(start[i + 1]));
     result.erase(std::unique(result.begin(), result.end()), result.end());
     return result;
   }
@@ -313,12 +320,13 @@ BroadPhase::~BroadPhase() = default;
 BroadPhase::BroadPhase(BroadPhase&&) noexcept = default;
 BroadPhase& BroadPhase::operator=(BroadPhase&&) noexcept = default;
 
-std::vector<std::pair<int, int>> BroadPhase::self_pairs(const std::vector<Box>& boxes) {
+std::vector<std::pair<int, int>> BroadPhase::self_pairs(const std::vector<Box>& boxes,
+                                                        const std::function<bool(int, int)>& keep) {
   validate(boxes, "the set");
   if (boxes.size() < 2) return {};
   if (!impl_) impl_ = std::make_unique<Impl>();
   impl_->update(impl_->self_scene, boxes);
-  return impl_->collide(impl_->self_scene, impl_->self_scene, boxes, boxes, true);
+  return impl_->collide(impl_->self_scene, impl_->self_scene, boxes, boxes, true, keep ? &keep : nullptr);
 }
 
 std::vector<std::pair<int, int>> BroadPhase::pairs(const std::vector<Box>& a,

@@ -43,6 +43,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -66,7 +67,11 @@ class BroadPhase {
 
   // All pairs (i, j), i < j, of boxes of one set that overlap (closed boxes: touching counts),
   // sorted lexicographically, without duplicates.
-  std::vector<std::pair<int, int>> self_pairs(const std::vector<Box>& boxes);
+  // `keep`, if given, is asked (from several threads at once, so it must only read) about each
+  // overlapping pair (i < j) and drops the pair when it returns false, before the pairs are
+  // gathered and sorted.
+  std::vector<std::pair<int, int>> self_pairs(const std::vector<Box>& boxes,
+                                              const std::function<bool(int, int)>& keep = {});
   // All pairs (i, j), i indexing a and j indexing b, whose boxes overlap, sorted
   // lexicographically. Empty if either set is empty.
   std::vector<std::pair<int, int>> pairs(const std::vector<Box>& a, const std::vector<Box>& b);

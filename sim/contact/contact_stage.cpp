@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -155,6 +156,7 @@ struct ContactStage::Impl {
   int fine_per_patch = 1;
   int num_patches = 0;
   std::vector<std::array<int, 3>> patch_vertices;  // the surface triangle's vertices
+  std::vector<std::vector<int>> patch_points;      // the fine points of each patch
 
   // Scratch for building constraints: slot per DOF (−1 when unused).
   std::vector<int> slot;
@@ -186,6 +188,14 @@ struct ContactStage::Impl {
     fine_per_patch = 1 << (2 * surface.levels);
     num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
     for (int t = 0; t < num_patches; ++t) patch_vertices.push_back(d.control_triangles()[static_cast<size_t>(t)]);
+    patch_points.resize(static_cast<size_t>(num_patches));
+    for (int t = 0; t < num_patches; ++t) {
+      std::vector<int>& pts = patch_points[static_cast<size_t>(t)];
+      for (int k = 0; k < fine_per_patch; ++k)
+        for (int v : surface.triangles[static_cast<size_t>(t * fine_per_patch + k)]) pts.push_back(v);
+      std::sort(pts.begin(), pts.end());
+      pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+    }
 
     std::vector<Triangle> tris;
     for (size_t k = 0; k < obstacles.size(); ++k) {
@@ -241,7 +251,11 @@ struct ContactStage::Impl {
   // --- Positions -------------------------------------------------------------------------------
   Eigen::Vector3d cloth(const Eigen::MatrixX3d& p, int i) const { return p.row(i).transpose(); }
 
+  bool end_points_current = false;  // p1 matches the velocities (no impulse since it was computed)
+
   void update_end_points(const Eigen::VectorXd& v) {
+    if (end_points_current) return;
+    end_points_current = true;
     const Eigen::VectorXd pv = jacobian * v;  // surface point velocities, flat
     p1 = p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
   }
@@ -297,42 +311,81 @@ struct ContactStage::Impl {
       a.hi = a.hi.cwiseMax(b.hi);
       return a;
     };
-    std::vector<Box> tight(surface.triangles.size());
+    // A box hierarchy over the refinement: level `levels` holds the fine triangles' swept boxes,
+    // level l − 1 the unions of each four children (triangle t of level l − 1 has children
+    // 4t … 4t + 3), level 0 the patches.
+    const int levels = surface.levels;
+    std::vector<std::vector<Box>> hierarchy(static_cast<size_t>(levels + 1));
+    hierarchy[static_cast<size_t>(levels)].resize(surface.triangles.size());
     for (size_t t = 0; t < surface.triangles.size(); ++t) {
       const auto& tri = surface.triangles[t];
-      tight[t] = unite(unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]),
-                       point_box[static_cast<size_t>(tri[2])]);
+      hierarchy[static_cast<size_t>(levels)][t] =
+          unite(unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]), point_box[static_cast<size_t>(tri[2])]);
     }
+    for (int l = levels; l > 0; --l) {
+      const std::vector<Box>& fine = hierarchy[static_cast<size_t>(l)];
+      std::vector<Box>& coarse = hierarchy[static_cast<size_t>(l - 1)];
+      coarse.resize(fine.size() / 4);
+      for (size_t t = 0; t < coarse.size(); ++t)
+        coarse[t] = unite(unite(fine[4 * t], fine[4 * t + 1]), unite(fine[4 * t + 2], fine[4 * t + 3]));
+    }
+    const std::vector<Box>& tight = hierarchy[static_cast<size_t>(levels)];
     std::vector<Box> patch_box(static_cast<size_t>(num_patches));
-    for (int q = 0; q < num_patches; ++q) {
-      Box b = tight[static_cast<size_t>(q * fine_per_patch)];
-      for (int k = 1; k < fine_per_patch; ++k) b = unite(b, tight[static_cast<size_t>(q * fine_per_patch + k)]);
-      patch_box[static_cast<size_t>(q)] = grown(b, 0.5 * grow);
-    }
+    for (int q = 0; q < num_patches; ++q) patch_box[static_cast<size_t>(q)] = grown(hierarchy[0][static_cast<size_t>(q)], 0.5 * grow);
+    auto triangle_box = [&](int t) -> const Box& { return tight[static_cast<size_t>(t)]; };
     std::vector<Box> edge_box(edges.size());
-    for (size_t e = 0; e < edges.size(); ++e)
-      edge_box[e] = grown(unite(point_box[static_cast<size_t>(edges[e][0])], point_box[static_cast<size_t>(edges[e][1])]), 0.5 * grow);
-    for (Box& b : point_box) b = grown(b, grow);
+    std::vector<char> edge_done(edges.size(), 0);
+    auto edge_swept = [&](int e) -> const Box& {
+      if (!edge_done[static_cast<size_t>(e)]) {
+        const auto& ed = edges[static_cast<size_t>(e)];
+        edge_box[static_cast<size_t>(e)] =
+            grown(unite(point_box[static_cast<size_t>(ed[0])], point_box[static_cast<size_t>(ed[1])]), 0.5 * grow);
+        edge_done[static_cast<size_t>(e)] = 1;
+      }
+      return edge_box[static_cast<size_t>(e)];
+    };
+    std::vector<Box> point_grown(point_box.size());
+    for (size_t p = 0; p < point_box.size(); ++p) point_grown[p] = grown(point_box[p], grow);
     // Two fine triangles of the cloth from patches that share no vertex: their owned points
     // against the other triangle, and their owned edges against each other.
     auto add_triangle_pair = [&](int i, int j) {
       for (int v : owned_points[static_cast<size_t>(i)])
-        if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(j)])) out.push_back({Kind::cloth_point_cloth_triangle, v, j});
+        if (overlap(point_grown[static_cast<size_t>(v)], triangle_box(j))) out.push_back({Kind::cloth_point_cloth_triangle, v, j});
       for (int v : owned_points[static_cast<size_t>(j)])
-        if (overlap(point_box[static_cast<size_t>(v)], tight[static_cast<size_t>(i)])) out.push_back({Kind::cloth_point_cloth_triangle, v, i});
+        if (overlap(point_grown[static_cast<size_t>(v)], triangle_box(i))) out.push_back({Kind::cloth_point_cloth_triangle, v, i});
       for (int ea : owned_edges[static_cast<size_t>(i)])
         for (int eb : owned_edges[static_cast<size_t>(j)])
-          if (overlap(edge_box[static_cast<size_t>(ea)], edge_box[static_cast<size_t>(eb)]))
+          if (overlap(edge_swept(ea), edge_swept(eb)))
             out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb)});
     };
-    if (settings.self) {
-      for (const auto& [qa, qb] : self_broad.self_pairs(patch_box)) {
-        if (shares_vertex(patch_vertices[static_cast<size_t>(qa)], patch_vertices[static_cast<size_t>(qb)])) continue;
-        for (int a = qa * fine_per_patch; a < (qa + 1) * fine_per_patch; ++a) {
-          const Box ga = grown(tight[static_cast<size_t>(a)], grow);
-          for (int b = qb * fine_per_patch; b < (qb + 1) * fine_per_patch; ++b)
-            if (overlap(ga, tight[static_cast<size_t>(b)])) add_triangle_pair(a, b);
+    // Down the hierarchy from a pair of boxes at level l whose (grown) boxes overlap.
+    struct Node {
+      int level, a, b;
+    };
+    std::vector<Node> stack;
+    auto descend = [&](int qa, int qb) {  // depth first, children in order: a fixed pair order
+      stack.clear();
+      stack.push_back({0, qa, qb});
+      while (!stack.empty()) {
+        const Node n = stack.back();
+        stack.pop_back();
+        const Box& ba = hierarchy[static_cast<size_t>(n.level)][static_cast<size_t>(n.a)];
+        const Box& bb = hierarchy[static_cast<size_t>(n.level)][static_cast<size_t>(n.b)];
+        if (!((ba.lo.array() - grow <= bb.hi.array()).all() && (bb.lo.array() <= ba.hi.array() + grow).all())) continue;
+        if (n.level == levels) {
+          add_triangle_pair(n.a, n.b);
+          continue;
         }
+        for (int i = 4 * n.a + 3; i >= 4 * n.a; --i)
+          for (int j = 4 * n.b + 3; j >= 4 * n.b; --j) stack.push_back({n.level + 1, i, j});
+      }
+    };
+    if (settings.self) {
+      const std::function<bool(int, int)> apart = [this](int qa, int qb) {
+        return !shares_vertex(patch_vertices[static_cast<size_t>(qa)], patch_vertices[static_cast<size_t>(qb)]);
+      };
+      for (const auto& [qa, qb] : self_broad.self_pairs(patch_box, apart)) {
+        descend(qa, qb);
       }
     }
     if (!obstacle_triangles.empty()) {
@@ -351,16 +404,16 @@ struct ContactStage::Impl {
       }
       for (const auto& [q, j] : obstacle_broad.pairs(patch_box, obstacle_boxes))
         for (int i = q * fine_per_patch; i < (q + 1) * fine_per_patch; ++i) {
-          if (!overlap(grown(tight[static_cast<size_t>(i)], grow), obstacle_boxes[static_cast<size_t>(j)])) continue;
+          if (!overlap(grown(triangle_box(i), grow), obstacle_boxes[static_cast<size_t>(j)])) continue;
           for (int v : owned_points[static_cast<size_t>(i)])
-            if (overlap(point_box[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
+            if (overlap(point_grown[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
               out.push_back({Kind::cloth_point_obstacle_triangle, v, j});
           for (int v : obstacle_owned_points[static_cast<size_t>(j)])
-            if (overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), tight[static_cast<size_t>(i)]))
+            if (overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), triangle_box(i)))
               out.push_back({Kind::obstacle_point_cloth_triangle, v, i});
           for (int ea : owned_edges[static_cast<size_t>(i)])
             for (int eb : obstacle_owned_edges[static_cast<size_t>(j)])
-              if (overlap(edge_box[static_cast<size_t>(ea)], obstacle_edge_box[static_cast<size_t>(eb)]))
+              if (overlap(edge_swept(ea), obstacle_edge_box[static_cast<size_t>(eb)]))
                 out.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
         }
     }
@@ -505,7 +558,8 @@ struct ContactStage::Impl {
     for (const auto& [dof, b] : c.b) k += inverse_mass(dof) * b.dot(e) * b.dot(e);
     return k;
   }
-  void apply(const Constraint& c, const Eigen::Vector3d& e, double lambda, Eigen::VectorXd& v) const {
+  void apply(const Constraint& c, const Eigen::Vector3d& e, double lambda, Eigen::VectorXd& v) {
+    end_points_current = false;
     for (const auto& [dof, b] : c.b) v(dof) += inverse_mass(dof) * lambda * b.dot(e);
   }
 
@@ -643,6 +697,7 @@ struct ContactStage::Impl {
   void move_zones(Zones& zones, const std::vector<int>& zone_obstacle, const Eigen::VectorXd& x, double t,
                   Eigen::VectorXd& v, ContactReport& report) {
     const auto t0 = Clock::now();
+    end_points_current = false;
     const int n = d.num_nodes();
     // Members of each zone: the nodes marked by a colliding pair, grouped by their root.
     std::map<int, std::vector<int>> members;
@@ -709,6 +764,7 @@ struct ContactStage::Impl {
     h = step;
     auto t0 = Clock::now();
     p0 = d.surface_positions(surface, x);
+    end_points_current = false;
     if (!obstacle_of_vertex.empty()) {
       o0.resize(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
       o1.resize(o0.rows(), 3);
@@ -724,6 +780,7 @@ struct ContactStage::Impl {
 
     // Proximity at the start of the step.
     std::vector<Candidate> cands = candidates(report);
+    bool cands_current = true;  // made for the current end points
     std::vector<Found> near = proximity(cands, t, report);
     report.proximity_pairs = static_cast<int>(near.size());
     for (Found& f : near) f.constraint.target = params.repulsion_ratio * (settings.thickness - f.distance) / h;
@@ -734,9 +791,11 @@ struct ContactStage::Impl {
     std::vector<Found> hits;
     for (int pass = 0; pass < params.ccd_passes; ++pass) {
       t0 = Clock::now();
+      const bool moved = !end_points_current;  // impulses since the candidates were made
       update_end_points(v);
       report.narrow_ms += ms_since(t0);
-      cands = candidates(report);
+      if (!cands_current || moved) cands = candidates(report);
+      cands_current = false;  // impulses below move the end points
       hits = collisions(cands, t, report);
       report.ccd_collisions += static_cast<int>(hits.size());
       if (hits.empty()) return report;
