@@ -39,6 +39,7 @@ enum class Kind : std::uint8_t {
 struct Candidate {
   Kind kind;
   int a, b;  // point and triangle, or edge and edge, in the order of the kind's name
+  bool near = false;  // from triangles near each other at rest: CCD only, at a tiny separation
   bool operator<(const Candidate& o) const {
     return std::tie(kind, a, b) < std::tie(o.kind, o.a, o.b);
   }
@@ -67,6 +68,7 @@ struct Constraint {
   double target = 0.0;    // wanted normal relative velocity [m/s]
   double mu = 0.0;        // friction coefficient
   double lambda = 0.0;    // accumulated normal impulse [N·s]
+  Eigen::Vector3d friction = Eigen::Vector3d::Zero();  // accumulated tangential impulse [N·s]
   int obstacle = -1;      // obstacle involved, or −1
 };
 
@@ -149,14 +151,16 @@ struct ContactStage::Impl {
 
   contact::BroadPhase self_broad, obstacle_broad;
   // Patches: the fine triangles over one surface triangle of the discretisation (display
-  // triangle i lies over surface triangle i / 4^levels). The broad phase works on patches; two
-  // patches whose surface triangles share a vertex never collide with each other (the surface
-  // over them is one smooth piece of a few elements, which the shell's bending keeps from folding
-  // onto itself; colliding them would hold the fine surface's neighbours apart).
+  // triangle i lies over surface triangle i / 4^levels). The broad phase works on patches, then
+  // down a box hierarchy to the fine triangles. Fine triangles of one patch never collide with
+  // each other (one smooth polynomial piece), nor do fine triangles closer than twice the
+  // thickness at rest (near_at_rest): they are neighbours in the material, which the shell keeps
+  // apart by itself, and colliding them would hold the fine surface's neighbours apart when it is
+  // compressed in its plane.
   int fine_per_patch = 1;
   int num_patches = 0;
-  std::vector<std::array<int, 3>> patch_vertices;  // the surface triangle's vertices
   std::vector<std::vector<int>> patch_points;      // the fine points of each patch
+  std::vector<std::vector<int>> near_at_rest;      // per fine triangle a: the sorted b > a near it at rest
 
   // Scratch for building constraints: slot per DOF (−1 when unused).
   std::vector<int> slot;
@@ -187,7 +191,7 @@ struct ContactStage::Impl {
                     owned_points, owned_edges);
     fine_per_patch = 1 << (2 * surface.levels);
     num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
-    for (int t = 0; t < num_patches; ++t) patch_vertices.push_back(d.control_triangles()[static_cast<size_t>(t)]);
+    if (settings.self) find_near_at_rest();
     patch_points.resize(static_cast<size_t>(num_patches));
     for (int t = 0; t < num_patches; ++t) {
       std::vector<int>& pts = patch_points[static_cast<size_t>(t)];
@@ -204,6 +208,11 @@ struct ContactStage::Impl {
       if (o.shape == Obstacle::Shape::plane) {
         planes.push_back(static_cast<int>(k));
         continue;
+      }
+      if (o.mesh.num_triangles() == 0) {
+        if (o.shape == Obstacle::Shape::mesh)
+          throw std::invalid_argument("obstacle " + o.name + ": a mesh obstacle needs triangles");
+        obstacles[k].mesh = tessellate(o);  // a primitive built in code without its tessellation
       }
       const int offset = vertex_offset.back();
       for (int v = 0; v < o.mesh.num_vertices(); ++v) obstacle_of_vertex.push_back(static_cast<int>(k));
@@ -271,6 +280,32 @@ struct ContactStage::Impl {
     box.lo.array() -= grow;
     box.hi.array() += grow;
     return box;
+  }
+
+  // Distance between two triangles of the collision surface at positions `p` [m].
+  double triangle_distance(const Eigen::MatrixX3d& p, const std::array<int, 3>& a, const std::array<int, 3>& b) const {
+    double dist = std::numeric_limits<double>::infinity();
+    auto pt = [&](int i) -> Eigen::Vector3d { return p.row(i).transpose(); };
+    for (size_t k = 0; k < 3; ++k) {
+      dist = std::min(dist, contact::point_triangle(pt(a[k]), pt(b[0]), pt(b[1]), pt(b[2])).distance);
+      dist = std::min(dist, contact::point_triangle(pt(b[k]), pt(a[0]), pt(a[1]), pt(a[2])).distance);
+      for (size_t l = 0; l < 3; ++l)
+        dist = std::min(dist, contact::edge_edge(pt(a[k]), pt(a[(k + 1) % 3]), pt(b[l]), pt(b[(l + 1) % 3])).distance);
+    }
+    return dist;
+  }
+
+  void find_near_at_rest() {
+    const double near = 2.0 * settings.thickness;
+    near_at_rest.assign(surface.triangles.size(), {});
+    std::vector<Box> boxes(surface.triangles.size());
+    for (size_t t = 0; t < surface.triangles.size(); ++t) boxes[t] = swept_box(rest_points, rest_points, surface.triangles[t], 0.5 * near);
+    contact::BroadPhase rest_broad;
+    for (const auto& [a, b] : rest_broad.self_pairs(boxes)) {
+      const auto& ta = surface.triangles[static_cast<size_t>(a)];
+      const auto& tb = surface.triangles[static_cast<size_t>(b)];
+      if (shares_vertex(ta, tb) || triangle_distance(rest_points, ta, tb) < near) near_at_rest[static_cast<size_t>(a)].push_back(b);
+    }  // sorted: the pairs come sorted
   }
 
   static bool shares_vertex(const std::array<int, 3>& a, const std::array<int, 3>& b) {
@@ -348,15 +383,28 @@ struct ContactStage::Impl {
     for (size_t p = 0; p < point_box.size(); ++p) point_grown[p] = grown(point_box[p], grow);
     // Two fine triangles of the cloth from patches that share no vertex: their owned points
     // against the other triangle, and their owned edges against each other.
-    auto add_triangle_pair = [&](int i, int j) {
+    auto add_triangle_pair = [&](int i, int j) {  // i < j
+      const std::vector<int>& near_i = near_at_rest[static_cast<size_t>(i)];
+      const bool near = std::binary_search(near_i.begin(), near_i.end(), j);
+      const auto& ti = surface.triangles[static_cast<size_t>(i)];
+      const auto& tj = surface.triangles[static_cast<size_t>(j)];
+      // (Triangles sharing a vertex still make pairs of their other points and edges: a point is
+      // tested through the triangle that owns it, which may be another neighbour.)
+      auto not_in = [](int v, const std::array<int, 3>& t) { return v != t[0] && v != t[1] && v != t[2]; };
       for (int v : owned_points[static_cast<size_t>(i)])
-        if (overlap(point_grown[static_cast<size_t>(v)], triangle_box(j))) out.push_back({Kind::cloth_point_cloth_triangle, v, j});
+        if (not_in(v, tj) && overlap(point_grown[static_cast<size_t>(v)], triangle_box(j)))
+          out.push_back({Kind::cloth_point_cloth_triangle, v, j, near});
       for (int v : owned_points[static_cast<size_t>(j)])
-        if (overlap(point_grown[static_cast<size_t>(v)], triangle_box(i))) out.push_back({Kind::cloth_point_cloth_triangle, v, i});
+        if (not_in(v, ti) && overlap(point_grown[static_cast<size_t>(v)], triangle_box(i)))
+          out.push_back({Kind::cloth_point_cloth_triangle, v, i, near});
       for (int ea : owned_edges[static_cast<size_t>(i)])
-        for (int eb : owned_edges[static_cast<size_t>(j)])
+        for (int eb : owned_edges[static_cast<size_t>(j)]) {
+          const auto& e = edges[static_cast<size_t>(ea)];
+          const auto& f = edges[static_cast<size_t>(eb)];
+          if (e[0] == f[0] || e[0] == f[1] || e[1] == f[0] || e[1] == f[1]) continue;
           if (overlap(edge_swept(ea), edge_swept(eb)))
-            out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb)});
+            out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb), near});
+        }
     };
     // Down the hierarchy from a pair of boxes at level l whose (grown) boxes overlap.
     struct Node {
@@ -381,12 +429,7 @@ struct ContactStage::Impl {
       }
     };
     if (settings.self) {
-      const std::function<bool(int, int)> apart = [this](int qa, int qb) {
-        return !shares_vertex(patch_vertices[static_cast<size_t>(qa)], patch_vertices[static_cast<size_t>(qb)]);
-      };
-      for (const auto& [qa, qb] : self_broad.self_pairs(patch_box, apart)) {
-        descend(qa, qb);
-      }
+      for (const auto& [qa, qb] : self_broad.self_pairs(patch_box)) descend(qa, qb);
     }
     if (!obstacle_triangles.empty()) {
       std::vector<Box> obstacle_boxes(obstacle_triangles.size());
@@ -558,6 +601,11 @@ struct ContactStage::Impl {
     for (const auto& [dof, b] : c.b) k += inverse_mass(dof) * b.dot(e) * b.dot(e);
     return k;
   }
+  // An impulse vector I: v[dof] += (B[dof]·I) / m.
+  void apply_vector(const Constraint& c, const Eigen::Vector3d& impulse, Eigen::VectorXd& v) {
+    end_points_current = false;
+    for (const auto& [dof, b] : c.b) v(dof) += inverse_mass(dof) * b.dot(impulse);
+  }
   void apply(const Constraint& c, const Eigen::Vector3d& e, double lambda, Eigen::VectorXd& v) {
     end_points_current = false;
     for (const auto& [dof, b] : c.b) v(dof) += inverse_mass(dof) * lambda * b.dot(e);
@@ -585,6 +633,7 @@ struct ContactStage::Impl {
   struct Found {
     Constraint constraint;
     double distance = 0.0;
+    double separation = 0.0;  // CCD: the separation the pair must keep [m]
   };
 
   // Planes: every surface point against every plane, at the start of the step (or, for
@@ -609,7 +658,7 @@ struct ContactStage::Impl {
         g.coef[0] = 1.0;
         g.normal = n0;
         g.distance = d0;
-        Found f{constraint(g), d0};
+        Found f{constraint(g), d0, limit};
         f.constraint.obstacle = k;
         f.constraint.mu = o.friction;
         f.constraint.obstacle_velocity = -(move(a) - a) / h;  // minus the plane's velocity at the point
@@ -623,6 +672,7 @@ struct ContactStage::Impl {
     const auto t0 = Clock::now();
     std::vector<Found> out;
     for (const Candidate& c : cands) {
+      if (c.near) continue;  // neighbours in the material: only kept from crossing (collisions)
       ++report.pairs_tested;
       const PairGeometry g = geometry(c, corners(c, false));
       if (g.distance < settings.thickness) out.push_back({constraint(g), g.distance});
@@ -634,21 +684,61 @@ struct ContactStage::Impl {
 
   // Pairs whose distance may fall below the minimum separation during the step (CCD), with their
   // geometry at the (conservative) time of impact.
-  std::vector<Found> collisions(const std::vector<Candidate>& cands, double t, ContactReport& report) {
+  // The cloth points of a pair (up to four; −1 for none).
+  std::array<int, 4> cloth_points_of(const Candidate& c) const {
+    switch (c.kind) {
+      case Kind::cloth_point_cloth_triangle: {
+        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+        return {c.a, t[0], t[1], t[2]};
+      }
+      case Kind::cloth_edge_cloth_edge: {
+        const auto& ea = edges[static_cast<size_t>(c.a)];
+        const auto& eb = edges[static_cast<size_t>(c.b)];
+        return {ea[0], ea[1], eb[0], eb[1]};
+      }
+      case Kind::cloth_point_obstacle_triangle: return {c.a, -1, -1, -1};
+      case Kind::obstacle_point_cloth_triangle: {
+        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+        return {t[0], t[1], t[2], -1};
+      }
+      case Kind::cloth_edge_obstacle_edge: {
+        const auto& ea = edges[static_cast<size_t>(c.a)];
+        return {ea[0], ea[1], -1, -1};
+      }
+    }
+    return {-1, -1, -1, -1};
+  }
+
+  // Pairs whose distance may fall below the minimum separation during the step. With `moved`
+  // (per surface point: its end position changed since the last test) and `last` (the pairs
+  // that collided then, sorted), only pairs with a moved point or a previous collision are
+  // tested again: the others have the same positions, so the same (negative) answer.
+  std::vector<Found> collisions(const std::vector<Candidate>& cands, double t, ContactReport& report,
+                                const std::vector<char>* moved = nullptr, const std::vector<Candidate>* last = nullptr,
+                                std::vector<Candidate>* hit_pairs = nullptr) {
     const auto t0 = Clock::now();
     const double eta = params.min_separation_ratio * settings.thickness;
     std::vector<Found> out;
+    if (hit_pairs) hit_pairs->clear();
     for (const Candidate& c : cands) {
+      if (moved != nullptr) {
+        bool any = false;
+        for (int p : cloth_points_of(c)) any = any || (p >= 0 && (*moved)[static_cast<size_t>(p)]);
+        if (!any && !std::binary_search(last->begin(), last->end(), c)) continue;
+      }
       ++report.pairs_tested;
       const std::array<Eigen::Vector3d, 4> a = corners(c, false), b = corners(c, true);
-      const contact::CcdResult r = is_point_triangle(c.kind) ? contact::point_triangle_ccd(a, b, eta)
-                                                             : contact::edge_edge_ccd(a, b, eta);
+      const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
+      const contact::CcdResult r = is_point_triangle(c.kind) ? contact::point_triangle_ccd(a, b, separation)
+                                                             : contact::edge_edge_ccd(a, b, separation);
       if (!r.hit) continue;
       std::array<Eigen::Vector3d, 4> x;
       for (size_t k = 0; k < 4; ++k) x[k] = a[k] + r.toi * (b[k] - a[k]);
       const PairGeometry g = geometry(c, x);
-      out.push_back({constraint(g), g.distance});
+      out.push_back({constraint(g), g.distance, separation});
+      if (hit_pairs) hit_pairs->push_back(c);
     }
+    if (hit_pairs) std::sort(hit_pairs->begin(), hit_pairs->end());
     plane_pairs(t, /*end=*/true, eta, out, report);
     report.narrow_ms += ms_since(t0);
     return out;
@@ -659,8 +749,11 @@ struct ContactStage::Impl {
   // then Coulomb friction bounded by μ times the normal impulse.
   void respond(std::vector<Found>& found, int sweeps, bool friction, Eigen::VectorXd& v, ContactReport& report) {
     const auto t0 = Clock::now();
+    // Sweeps until no constraint misses its target by more than `tolerance` (0.01 % of the
+    // thickness per step), at most `sweeps`.
+    const double tolerance = 1e-4 * settings.thickness / h;
     for (int sweep = 0; sweep < sweeps; ++sweep) {
-      bool changed = false;
+      double worst = 0.0;
       for (Found& f : found) {
         Constraint& c = f.constraint;
         const double k = inverse_mass_along(c, c.normal);
@@ -668,27 +761,45 @@ struct ContactStage::Impl {
         const double vn = c.normal.dot(relative_velocity(c, v));
         const double lambda = std::max(0.0, c.lambda + (c.target - vn) / k);
         if (lambda != c.lambda) {
+          worst = std::max(worst, std::abs(lambda - c.lambda) * k);
           apply(c, c.normal, lambda - c.lambda, v);
           c.lambda = lambda;
           ++report.impulses;
-          changed = true;
         }
       }
-      if (!changed) break;
+      if (worst <= tolerance) break;
     }
+    // Coulomb friction, also by sweeps: each pair's accumulated tangential impulse is moved
+    // towards the one that stops its sliding and clamped to the cone |I_t| ≤ μ λ_n (so coupled
+    // pairs, which share nodes, settle together instead of overshooting one after another).
     if (friction)
-      for (Found& f : found) {
-        Constraint& c = f.constraint;
-        if (!(c.lambda > 0) || !(c.mu > 0)) continue;
-        const Eigen::Vector3d u = relative_velocity(c, v);
-        const Eigen::Vector3d ut = u - c.normal.dot(u) * c.normal;
-        const double speed = ut.norm();
-        if (!(speed > 0)) continue;
-        const Eigen::Vector3d e = ut / speed;
-        const double k = inverse_mass_along(c, e);
-        if (!(k > 0)) continue;
-        apply(c, e, -std::min(speed / k, c.mu * c.lambda), v);  // never reverses the sliding
-        ++report.impulses;
+      for (int sweep = 0; sweep < sweeps; ++sweep) {
+        double worst = 0.0;
+        for (Found& f : found) {
+          Constraint& c = f.constraint;
+          if (!(c.lambda > 0) || !(c.mu > 0)) continue;
+          const Eigen::Vector3d u = relative_velocity(c, v);
+          const Eigen::Vector3d ut = u - c.normal.dot(u) * c.normal;
+          const double speed = ut.norm();
+          Eigen::Vector3d wanted = c.friction;
+          double k = 0.0;
+          if (speed > 0) {
+            const Eigen::Vector3d e = ut / speed;
+            k = inverse_mass_along(c, e);
+            if (!(k > 0)) continue;
+            wanted -= (speed / k) * e;
+          }
+          wanted -= c.normal.dot(wanted) * c.normal;
+          const double limit = c.mu * c.lambda;
+          if (wanted.norm() > limit) wanted *= limit / wanted.norm();
+          const Eigen::Vector3d change = wanted - c.friction;
+          if (change.squaredNorm() == 0.0) continue;
+          apply_vector(c, change, v);
+          c.friction = wanted;
+          ++report.impulses;
+          worst = std::max(worst, change.norm() * std::max(k, inverse_mass_along(c, change.normalized())));
+        }
+        if (worst <= tolerance) break;
       }
     report.response_ms += ms_since(t0);
   }
@@ -787,19 +898,30 @@ struct ContactStage::Impl {
     respond(near, params.proximity_sweeps, /*friction=*/true, v, report);
 
     // Continuous collision detection and inelastic impulses.
-    const double eta = params.min_separation_ratio * settings.thickness;
     std::vector<Found> hits;
+    std::vector<Candidate> last_hits;
+    std::vector<char> moved;
+    Eigen::MatrixX3d p1_tested;  // end points of the last test
     for (int pass = 0; pass < params.ccd_passes; ++pass) {
       t0 = Clock::now();
-      const bool moved = !end_points_current;  // impulses since the candidates were made
+      const bool changed = !end_points_current;  // impulses since the candidates were made
       update_end_points(v);
       report.narrow_ms += ms_since(t0);
-      if (!cands_current || moved) cands = candidates(report);
+      if (!cands_current || changed) cands = candidates(report);
       cands_current = false;  // impulses below move the end points
-      hits = collisions(cands, t, report);
+      if (pass == 0) {
+        hits = collisions(cands, t, report, nullptr, nullptr, &last_hits);
+      } else {
+        moved.assign(static_cast<size_t>(p1.rows()), 0);
+        for (Eigen::Index p = 0; p < p1.rows(); ++p) moved[static_cast<size_t>(p)] = p1.row(p) != p1_tested.row(p);
+        std::vector<Candidate> previous;
+        previous.swap(last_hits);
+        hits = collisions(cands, t, report, &moved, &previous, &last_hits);
+      }
+      p1_tested = p1;
       report.ccd_collisions += static_cast<int>(hits.size());
       if (hits.empty()) return report;
-      for (Found& f : hits) f.constraint.target = std::max(0.0, (eta - f.distance) / h);
+      for (Found& f : hits) f.constraint.target = std::max(0.0, (f.separation - f.distance) / h);
       respond(hits, 1, /*friction=*/false, v, report);
     }
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -11,9 +12,10 @@ namespace clothsim {
 
 namespace {
 
-// Segments around a circle of radius r so that a chord's sagitta r (1 − cos(π/n)) stays below
-// 0.2 % of r: n ≥ π / acos(0.998) ≈ 49.7.
-constexpr int kSegments = 50;
+// Segments around a circle of radius r: 72 (5°), so that a chord's sagitta r (1 − cos(π/n)) is
+// 0.095 % of r, and on a capsule's caps (latitude steps of 5°) the diagonals of the quads
+// (7.1°) sag by at most 0.19 % of r.
+constexpr int kSegments = 72;
 
 // A unit vector perpendicular to `a` (unit), and a third completing a right-handed frame.
 void frame_of(const Eigen::Vector3d& a, Eigen::Vector3d& e1, Eigen::Vector3d& e2) {
@@ -102,7 +104,7 @@ TriMesh round_mesh(const Eigen::Vector3d& from, const Eigen::Vector3d& to, doubl
   };
   // Rings from the `from` end to the `to` end; consecutive rings are joined by quads.
   std::vector<int> rings;
-  const int cap_rings = caps_round ? n / 4 : 0;  // latitude steps of π/2 / (n/4)
+  const int cap_rings = caps_round ? 18 : 0;  // latitude steps of π/(2·18) = 5°
   for (int k = cap_rings - 1; k >= 1; --k) {  // latitudes between the pole and the equator
     const double phi = 0.5 * M_PI * k / cap_rings;
     rings.push_back(ring(from - r * std::sin(phi) * axis, r * std::cos(phi)));
@@ -111,7 +113,8 @@ TriMesh round_mesh(const Eigen::Vector3d& from, const Eigen::Vector3d& to, doubl
   // The side: straight, with rings no farther apart than the segment length (better-shaped
   // triangles; they do not change the surface).
   const double length = (to - from).norm();
-  const int along = std::max(1, static_cast<int>(std::ceil(length / (2.0 * M_PI * r / n))));
+  // (At most 200 rings along a long, thin body: the rings only shape the triangles.)
+  const int along = std::clamp(static_cast<int>(std::ceil(length / (2.0 * M_PI * r / n))), 1, 200);
   for (int k = 1; k <= along; ++k) rings.push_back(ring(from + (length * k / along) * axis, r));
   for (int k = 1; k < cap_rings; ++k) {
     const double phi = 0.5 * M_PI * k / cap_rings;

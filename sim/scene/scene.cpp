@@ -309,7 +309,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
     r.fail(path, "needs \"obj\" (a file) or \"primitive\" (allowed: \"grid\", \"cylinder\")");
 
   if (has_obj) {
-    r.check_object(j, path, {"obj"});  // ("rotate" and "translate" are read by build_mesh)
+    r.check_object(j, path, {"obj", "rotate", "translate"});  // (the placement is read by build_mesh)
     const std::string key = "mesh.obj";
     const std::string name = r.string(j["obj"], key);
     if (name.empty()) r.fail(key, "expected a non-empty file path");
@@ -328,7 +328,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
   TriMesh mesh;
   try {
     if (primitive == "grid") {
-      r.check_object(j, path, {"primitive", "size", "divisions"});
+      r.check_object(j, path, {"primitive", "size", "divisions", "rotate", "translate"});
       const Json& size = r.sized_array(r.require(j, path, "size"), "mesh.size", 2, "numbers");
       const Json& div = r.sized_array(r.require(j, path, "divisions"), "mesh.divisions", 2, "integers");
       const double sx = r.positive(size[0], "mesh.size[0]", "[m]");
@@ -339,7 +339,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
       log("mesh: grid " + format_number(sx) + " m x " + format_number(sy) + " m, " + std::to_string(dx) +
           " x " + std::to_string(dy) + " divisions");
     } else {
-      r.check_object(j, path, {"primitive", "radius", "length", "segments", "rings", "angle_deg"});
+      r.check_object(j, path, {"primitive", "radius", "length", "segments", "rings", "angle_deg", "rotate", "translate"});
       const double radius = r.positive(r.require(j, path, "radius"), "mesh.radius", "[m]");
       const double length = r.positive(r.require(j, path, "length"), "mesh.length", "[m]");
       double angle = 360.0;
@@ -736,7 +736,9 @@ std::vector<Obstacle> read_obstacles(const Reader& r, const Json* j, double defa
       o.name = r.string(*v, key("name"));
       if (o.name.empty()) r.fail(key("name"), "must not be empty");
     }
-    if (!names.insert(o.name).second) r.fail(key("name"), "duplicate obstacle name " + quote(o.name));
+    if (!names.insert(o.name).second)
+      r.fail(item.contains("name") ? key("name") : path, "duplicate obstacle name " + quote(o.name) +
+                                                              (item.contains("name") ? "" : " (the default name of this unnamed obstacle)"));
     if (const Json* v = r.find(item, "friction")) o.friction = r.non_negative(*v, key("friction"), "[-]");
     if (const Json* motion = r.find(item, "motion")) {
       r.array(*motion, key("motion"));
