@@ -10,6 +10,8 @@
 #include "tests/support/process.hpp"
 
 #include <Eigen/Geometry>
+#include "tests/support/scene_files.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -65,46 +67,7 @@ std::string dynamic_scene(const std::string& rest) {
 // A scene with one obstacle list (and no collision block).
 std::string with_obstacles(const std::string& list) { return dynamic_scene(R"(, "obstacles": )" + list); }
 
-class ContactKeys : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "clothsim_contact_keys_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
-  fs::path write(const std::string& name, const std::string& text) const {
-    const fs::path path = dir_ / name;
-    fs::create_directories(path.parent_path());
-    std::ofstream(path) << text;
-    return path;
-  }
-
-  Scene load(const std::string& text, const std::string& name = "scene.json") const {
-    return load_scene(write(name, text), nullptr);
-  }
-
-  // The SceneError message for `text`, or "no error".
-  std::string error(const std::string& text, const std::string& name = "scene.json") const {
-    try {
-      load(text, name);
-    } catch (const SceneError& e) {
-      return e.what();
-    }
-    return "no error";
-  }
-
-  // The message expected for a problem at a key, with the file prefix.
-  std::string expected(const std::string& key_and_problem) const {
-    return (dir_ / "scene.json").string() + ": " + key_and_problem;
-  }
-
-  fs::path dir_;
-};
+class ContactKeys : public testing::SceneFileTest {};
 
 const Obstacle* find_obstacle(const Scene& s, const std::string& name) {
   for (const Obstacle& o : s.problem.obstacles)

@@ -6,6 +6,8 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/shell/material_presets.hpp"
 
+#include "tests/support/scene_files.hpp"
+
 #include <gtest/gtest.h>
 
 #include <stdlib.h>
@@ -25,46 +27,7 @@ namespace fs = std::filesystem;
 
 const char* const kGrid4 = R"("mesh": {"primitive": "grid", "size": [1.0, 1.0], "divisions": [4, 4]})";
 
-class SceneLoader : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "clothsim_scene_test_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-
-  fs::path write(const std::string& name, const std::string& text) const {
-    const fs::path path = dir_ / name;
-    fs::create_directories(path.parent_path());
-    std::ofstream(path) << text;
-    return path;
-  }
-
-  Scene load(const std::string& text, const std::string& name = "scene.json") const {
-    return load_scene(write(name, text), nullptr);
-  }
-
-  // The SceneError message for `text`, or "no error".
-  std::string error(const std::string& text, const std::string& name = "scene.json") const {
-    try {
-      load(text, name);
-    } catch (const SceneError& e) {
-      return e.what();
-    }
-    return "no error";
-  }
-
-  // The message expected for a problem at `key`, with the file prefix.
-  std::string expected(const std::string& key_and_problem) const {
-    return (dir_ / "scene.json").string() + ": " + key_and_problem;
-  }
-
-  fs::path dir_;
-};
+class SceneLoader : public testing::SceneFileTest {};
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
