@@ -2,10 +2,14 @@
 
 #include "sim/contact/narrow_phase.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
 #include <algorithm>
+#include <atomic>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -671,11 +675,17 @@ struct ContactStage::Impl {
   std::vector<Found> proximity(const std::vector<Candidate>& cands, double t, ContactReport& report) {
     const auto t0 = Clock::now();
     std::vector<Found> out;
-    for (const Candidate& c : cands) {
-      if (c.near) continue;  // neighbours in the material: only kept from crossing (collisions)
-      ++report.pairs_tested;
-      const PairGeometry g = geometry(c, corners(c, false));
-      if (g.distance < settings.thickness) out.push_back({constraint(g), g.distance});
+    std::vector<char> close(cands.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i)
+        if (!cands[i].near)  // neighbours in the material: only kept from crossing (collisions)
+          close[i] = geometry(cands[i], corners(cands[i], false)).distance < settings.thickness;
+    });
+    for (size_t i = 0; i < cands.size(); ++i) {
+      if (!cands[i].near) ++report.pairs_tested;
+      if (!close[i]) continue;
+      const PairGeometry g = geometry(cands[i], corners(cands[i], false));
+      out.push_back({constraint(g), g.distance});
     }
     plane_pairs(t, /*end=*/false, settings.thickness, out, report);
     report.narrow_ms += ms_since(t0);
@@ -720,20 +730,35 @@ struct ContactStage::Impl {
     const double eta = params.min_separation_ratio * settings.thickness;
     std::vector<Found> out;
     if (hit_pairs) hit_pairs->clear();
-    for (const Candidate& c : cands) {
-      if (moved != nullptr) {
-        bool any = false;
-        for (int p : cloth_points_of(c)) any = any || (p >= 0 && (*moved)[static_cast<size_t>(p)]);
-        if (!any && !std::binary_search(last->begin(), last->end(), c)) continue;
+    // The CCD of every pair in parallel (each pair alone), then the hits in the pairs' order.
+    std::vector<double> toi(cands.size(), -1.0);  // −1: not tested or no hit
+    std::atomic<long long> tested{0};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+      long long count = 0;
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Candidate& c = cands[i];
+        if (moved != nullptr) {
+          bool any = false;
+          for (int p : cloth_points_of(c)) any = any || (p >= 0 && (*moved)[static_cast<size_t>(p)]);
+          if (!any && !std::binary_search(last->begin(), last->end(), c)) continue;
+        }
+        ++count;
+        const std::array<Eigen::Vector3d, 4> a = corners(c, false), b = corners(c, true);
+        const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
+        const contact::CcdResult r = is_point_triangle(c.kind) ? contact::point_triangle_ccd(a, b, separation)
+                                                               : contact::edge_edge_ccd(a, b, separation);
+        if (r.hit) toi[i] = r.toi;
       }
-      ++report.pairs_tested;
+      tested += count;
+    });
+    report.pairs_tested += tested.load();
+    for (size_t i = 0; i < cands.size(); ++i) {
+      if (toi[i] < 0) continue;
+      const Candidate& c = cands[i];
       const std::array<Eigen::Vector3d, 4> a = corners(c, false), b = corners(c, true);
       const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
-      const contact::CcdResult r = is_point_triangle(c.kind) ? contact::point_triangle_ccd(a, b, separation)
-                                                             : contact::edge_edge_ccd(a, b, separation);
-      if (!r.hit) continue;
       std::array<Eigen::Vector3d, 4> x;
-      for (size_t k = 0; k < 4; ++k) x[k] = a[k] + r.toi * (b[k] - a[k]);
+      for (size_t k = 0; k < 4; ++k) x[k] = a[k] + toi[i] * (b[k] - a[k]);
       const PairGeometry g = geometry(c, x);
       out.push_back({constraint(g), g.distance, separation});
       if (hit_pairs) hit_pairs->push_back(c);
