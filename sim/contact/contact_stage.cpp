@@ -774,9 +774,9 @@ struct ContactStage::Impl {
   // then Coulomb friction bounded by μ times the normal impulse.
   void respond(std::vector<Found>& found, int sweeps, bool friction, Eigen::VectorXd& v, ContactReport& report) {
     const auto t0 = Clock::now();
-    // Sweeps until no constraint misses its target by more than `tolerance` (0.01 % of the
+    // Sweeps until no constraint misses its target by more than `tolerance` (0.1 % of the
     // thickness per step), at most `sweeps`.
-    const double tolerance = 1e-4 * settings.thickness / h;
+    const double tolerance = 1e-3 * settings.thickness / h;
     for (int sweep = 0; sweep < sweeps; ++sweep) {
       double worst = 0.0;
       for (Found& f : found) {

@@ -58,8 +58,8 @@ struct ContactParameters {
   double min_separation_ratio = 0.1; // CCD keeps this fraction of the thickness
   double near_separation_ratio = 0.01;  // ... and this fraction between parts near each other at rest
   double repulsion_ratio = 0.1;      // proximity pushes apart at most this fraction of the overlap per step
-  int proximity_sweeps = 100;        // Gauss–Seidel sweeps over the proximity pairs, at most (they
-                                     // stop when every target is met to 1e-4 thickness per step)
+  int proximity_sweeps = 50;         // Gauss–Seidel sweeps over the proximity pairs, at most (they
+                                     // stop when every target is met to 1e-3 thickness per step)
   int ccd_passes = 8;                // CCD and impulse passes before the fail-safe
   int zone_rounds = 100;             // fail-safe rounds before giving up (reported as unresolved)
 };
