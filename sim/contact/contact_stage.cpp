@@ -171,6 +171,8 @@ struct ContactStage::Impl {
 
   // Per step.
   Eigen::MatrixX3d p0, p1;          // surface points at the start and end of the step
+  std::vector<Box> obstacle_boxes, obstacle_point_box, obstacle_edge_box;  // swept over the step
+  bool obstacle_boxes_current = false;
   Eigen::MatrixX3d o0, o1;          // obstacle vertices at t and t + h
   double h = 0.0;
 
@@ -436,18 +438,21 @@ struct ContactStage::Impl {
       for (const auto& [qa, qb] : self_broad.self_pairs(patch_box)) descend(qa, qb);
     }
     if (!obstacle_triangles.empty()) {
-      std::vector<Box> obstacle_boxes(obstacle_triangles.size());
-      for (size_t t = 0; t < obstacle_triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obstacle_triangles[t], 0.0);
-      std::vector<Box> obstacle_point_box(obstacle_of_vertex.size());
-      for (size_t v = 0; v < obstacle_point_box.size(); ++v) {
-        const int i = static_cast<int>(v);
-        obstacle_point_box[v] = swept_box(o0, o1, {i, i, i}, 0.0);
-      }
-      std::vector<Box> obstacle_edge_box(obstacle_edges.size());
-      for (size_t e = 0; e < obstacle_edges.size(); ++e) {
-        const Box& a = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][0])];
-        const Box& b = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][1])];
-        obstacle_edge_box[e] = grown(Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}, 0.5 * grow);
+      if (!obstacle_boxes_current) {  // once per step: the obstacles' motion is known for the step
+        obstacle_boxes.resize(obstacle_triangles.size());
+        for (size_t t = 0; t < obstacle_triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obstacle_triangles[t], 0.0);
+        obstacle_point_box.resize(obstacle_of_vertex.size());
+        for (size_t v = 0; v < obstacle_point_box.size(); ++v) {
+          const int i = static_cast<int>(v);
+          obstacle_point_box[v] = swept_box(o0, o1, {i, i, i}, 0.0);
+        }
+        obstacle_edge_box.resize(obstacle_edges.size());
+        for (size_t e = 0; e < obstacle_edges.size(); ++e) {
+          const Box& a = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][0])];
+          const Box& b = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][1])];
+          obstacle_edge_box[e] = grown(Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}, 0.5 * grow);
+        }
+        obstacle_boxes_current = true;
       }
       for (const auto& [q, j] : obstacle_broad.pairs(patch_box, obstacle_boxes))
         for (int i = q * fine_per_patch; i < (q + 1) * fine_per_patch; ++i) {
@@ -901,6 +906,7 @@ struct ContactStage::Impl {
     auto t0 = Clock::now();
     p0 = d.surface_positions(surface, x);
     end_points_current = false;
+    obstacle_boxes_current = false;
     if (!obstacle_of_vertex.empty()) {
       o0.resize(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
       o1.resize(o0.rows(), 3);
