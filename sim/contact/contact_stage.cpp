@@ -389,6 +389,7 @@ struct ContactStage::Impl {
     for (size_t p = 0; p < point_box.size(); ++p) point_grown[p] = grown(point_box[p], grow);
     // Two fine triangles of the cloth from patches that share no vertex: their owned points
     // against the other triangle, and their owned edges against each other.
+    const double near_growth = params.near_separation_ratio * settings.thickness;
     auto add_triangle_pair = [&](int i, int j) {  // i < j
       const std::vector<int>& near_i = near_at_rest[static_cast<size_t>(i)];
       const bool near = std::binary_search(near_i.begin(), near_i.end(), j);
@@ -397,18 +398,28 @@ struct ContactStage::Impl {
       // (Triangles sharing a vertex still make pairs of their other points and edges: a point is
       // tested through the triangle that owns it, which may be another neighbour.)
       auto not_in = [](int v, const std::array<int, 3>& t) { return v != t[0] && v != t[1] && v != t[2]; };
+      // Near pairs are only kept from crossing (CCD down to near_separation), so their boxes are
+      // grown by that separation, not by the thickness.
+      const double g_point = near ? near_growth : grow, g_edge = 0.5 * g_point;
+      auto point_reach = [&](int v) { return near ? grown(point_box[static_cast<size_t>(v)], g_point) : point_grown[static_cast<size_t>(v)]; };
+      auto edge_reach = [&](int e) {
+        if (!near) return edge_swept(e);
+        const auto& ed = edges[static_cast<size_t>(e)];
+        return grown(unite(point_box[static_cast<size_t>(ed[0])], point_box[static_cast<size_t>(ed[1])]), g_edge);
+      };
+      if (near && !overlap(grown(triangle_box(i), g_point), triangle_box(j))) return;
       for (int v : owned_points[static_cast<size_t>(i)])
-        if (not_in(v, tj) && overlap(point_grown[static_cast<size_t>(v)], triangle_box(j)))
+        if (not_in(v, tj) && overlap(point_reach(v), triangle_box(j)))
           out.push_back({Kind::cloth_point_cloth_triangle, v, j, near});
       for (int v : owned_points[static_cast<size_t>(j)])
-        if (not_in(v, ti) && overlap(point_grown[static_cast<size_t>(v)], triangle_box(i)))
+        if (not_in(v, ti) && overlap(point_reach(v), triangle_box(i)))
           out.push_back({Kind::cloth_point_cloth_triangle, v, i, near});
       for (int ea : owned_edges[static_cast<size_t>(i)])
         for (int eb : owned_edges[static_cast<size_t>(j)]) {
           const auto& e = edges[static_cast<size_t>(ea)];
           const auto& f = edges[static_cast<size_t>(eb)];
           if (e[0] == f[0] || e[0] == f[1] || e[1] == f[0] || e[1] == f[1]) continue;
-          if (overlap(edge_swept(ea), edge_swept(eb)))
+          if (overlap(edge_reach(ea), edge_reach(eb)))
             out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb), near});
         }
     };
