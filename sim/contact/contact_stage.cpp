@@ -164,6 +164,7 @@ struct ContactStage::Impl {
   int fine_per_patch = 1;
   int num_patches = 0;
   std::vector<std::vector<int>> patch_points;      // the fine points of each patch
+  std::vector<std::array<int, 3>> patch_corners;   // the surface triangle under each patch
   std::vector<std::vector<int>> near_at_rest;      // per fine triangle a: the sorted b > a near it at rest
 
   // Scratch for building constraints: slot per DOF (−1 when unused).
@@ -198,6 +199,7 @@ struct ContactStage::Impl {
     fine_per_patch = 1 << (2 * surface.levels);
     num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
     if (settings.self) find_near_at_rest();
+    for (int t = 0; t < num_patches; ++t) patch_corners.push_back(d.control_triangles()[static_cast<size_t>(t)]);
     patch_points.resize(static_cast<size_t>(num_patches));
     for (int t = 0; t < num_patches; ++t) {
       std::vector<int>& pts = patch_points[static_cast<size_t>(t)];
@@ -340,13 +342,15 @@ struct ContactStage::Impl {
     // Swept boxes of the points first (p0 and p1 per point), then of triangles and edges as unions.
     const Eigen::Index np = p0.rows();
     std::vector<Box> point_box(static_cast<size_t>(np));
-    for (Eigen::Index p = 0; p < np; ++p) {
-      Box& b = point_box[static_cast<size_t>(p)];
-      for (int k = 0; k < 3; ++k) {
-        b.lo[k] = std::min(p0(p, k), p1(p, k));
-        b.hi[k] = std::max(p0(p, k), p1(p, k));
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, np, 4096), [&](const tbb::blocked_range<Eigen::Index>& range) {
+      for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
+        Box& b = point_box[static_cast<size_t>(p)];
+        for (int k = 0; k < 3; ++k) {
+          b.lo[k] = std::min(p0(p, k), p1(p, k));
+          b.hi[k] = std::max(p0(p, k), p1(p, k));
+        }
       }
-    }
+    });
     auto unite = [](Box a, const Box& b) {
       a.lo = a.lo.cwiseMin(b.lo);
       a.hi = a.hi.cwiseMax(b.hi);
@@ -358,11 +362,13 @@ struct ContactStage::Impl {
     const int levels = surface.levels;
     std::vector<std::vector<Box>> hierarchy(static_cast<size_t>(levels + 1));
     hierarchy[static_cast<size_t>(levels)].resize(surface.triangles.size());
-    for (size_t t = 0; t < surface.triangles.size(); ++t) {
-      const auto& tri = surface.triangles[t];
-      hierarchy[static_cast<size_t>(levels)][t] =
-          unite(unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]), point_box[static_cast<size_t>(tri[2])]);
-    }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, surface.triangles.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t t = range.begin(); t != range.end(); ++t) {
+        const auto& tri = surface.triangles[t];
+        hierarchy[static_cast<size_t>(levels)][t] = unite(
+            unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]), point_box[static_cast<size_t>(tri[2])]);
+      }
+    });
     for (int l = levels; l > 0; --l) {
       const std::vector<Box>& fine = hierarchy[static_cast<size_t>(l)];
       std::vector<Box>& coarse = hierarchy[static_cast<size_t>(l - 1)];
@@ -374,25 +380,18 @@ struct ContactStage::Impl {
     std::vector<Box> patch_box(static_cast<size_t>(num_patches));
     for (int q = 0; q < num_patches; ++q) patch_box[static_cast<size_t>(q)] = grown(hierarchy[0][static_cast<size_t>(q)], 0.5 * grow);
     auto triangle_box = [&](int t) -> const Box& { return tight[static_cast<size_t>(t)]; };
-    std::vector<Box> edge_box(edges.size());
-    std::vector<char> edge_done(edges.size(), 0);
-    auto edge_swept = [&](int e) -> const Box& {
-      if (!edge_done[static_cast<size_t>(e)]) {
-        const auto& ed = edges[static_cast<size_t>(e)];
-        edge_box[static_cast<size_t>(e)] =
-            grown(unite(point_box[static_cast<size_t>(ed[0])], point_box[static_cast<size_t>(ed[1])]), 0.5 * grow);
-        edge_done[static_cast<size_t>(e)] = 1;
-      }
-      return edge_box[static_cast<size_t>(e)];
+    auto edge_swept = [&](int e) {  // (computed where needed; read-only, so safe in parallel)
+      const auto& ed = edges[static_cast<size_t>(e)];
+      return grown(unite(point_box[static_cast<size_t>(ed[0])], point_box[static_cast<size_t>(ed[1])]), 0.5 * grow);
     };
     std::vector<Box> point_grown(point_box.size());
     for (size_t p = 0; p < point_box.size(); ++p) point_grown[p] = grown(point_box[p], grow);
     // Two fine triangles of the cloth from patches that share no vertex: their owned points
     // against the other triangle, and their owned edges against each other.
     const double near_growth = params.near_separation_ratio * settings.thickness;
-    auto add_triangle_pair = [&](int i, int j) {  // i < j
+    auto add_triangle_pair = [&](int i, int j, bool neighbours, std::vector<Candidate>& into) {  // i < j
       const std::vector<int>& near_i = near_at_rest[static_cast<size_t>(i)];
-      const bool near = std::binary_search(near_i.begin(), near_i.end(), j);
+      const bool near = neighbours || std::binary_search(near_i.begin(), near_i.end(), j);
       const auto& ti = surface.triangles[static_cast<size_t>(i)];
       const auto& tj = surface.triangles[static_cast<size_t>(j)];
       // (Triangles sharing a vertex still make pairs of their other points and edges: a point is
@@ -410,25 +409,28 @@ struct ContactStage::Impl {
       if (near && !overlap(grown(triangle_box(i), g_point), triangle_box(j))) return;
       for (int v : owned_points[static_cast<size_t>(i)])
         if (not_in(v, tj) && overlap(point_reach(v), triangle_box(j)))
-          out.push_back({Kind::cloth_point_cloth_triangle, v, j, near});
+          into.push_back({Kind::cloth_point_cloth_triangle, v, j, near});
       for (int v : owned_points[static_cast<size_t>(j)])
         if (not_in(v, ti) && overlap(point_reach(v), triangle_box(i)))
-          out.push_back({Kind::cloth_point_cloth_triangle, v, i, near});
+          into.push_back({Kind::cloth_point_cloth_triangle, v, i, near});
       for (int ea : owned_edges[static_cast<size_t>(i)])
         for (int eb : owned_edges[static_cast<size_t>(j)]) {
           const auto& e = edges[static_cast<size_t>(ea)];
           const auto& f = edges[static_cast<size_t>(eb)];
           if (e[0] == f[0] || e[0] == f[1] || e[1] == f[0] || e[1] == f[1]) continue;
           if (overlap(edge_reach(ea), edge_reach(eb)))
-            out.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb), near});
+            into.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb), near});
         }
     };
     // Down the hierarchy from a pair of boxes at level l whose (grown) boxes overlap.
     struct Node {
       int level, a, b;
     };
-    std::vector<Node> stack;
-    auto descend = [&](int qa, int qb) {  // depth first, children in order: a fixed pair order
+    // Patches over surface triangles that share a vertex are neighbours: all their fine pairs are
+    // near pairs (kept from crossing only), and their boxes grow by the near separation.
+    auto descend = [&](int qa, int qb, std::vector<Node>& stack, std::vector<Candidate>& into) {  // depth first, fixed order
+      const bool neighbours = shares_vertex(patch_corners[static_cast<size_t>(qa)], patch_corners[static_cast<size_t>(qb)]);
+      const double g = neighbours ? near_growth : grow;
       stack.clear();
       stack.push_back({0, qa, qb});
       while (!stack.empty()) {
@@ -436,9 +438,9 @@ struct ContactStage::Impl {
         stack.pop_back();
         const Box& ba = hierarchy[static_cast<size_t>(n.level)][static_cast<size_t>(n.a)];
         const Box& bb = hierarchy[static_cast<size_t>(n.level)][static_cast<size_t>(n.b)];
-        if (!((ba.lo.array() - grow <= bb.hi.array()).all() && (bb.lo.array() <= ba.hi.array() + grow).all())) continue;
+        if (!((ba.lo.array() - g <= bb.hi.array()).all() && (bb.lo.array() <= ba.hi.array() + g).all())) continue;
         if (n.level == levels) {
-          add_triangle_pair(n.a, n.b);
+          add_triangle_pair(n.a, n.b, neighbours, into);
           continue;
         }
         for (int i = 4 * n.a + 3; i >= 4 * n.a; --i)
@@ -446,7 +448,18 @@ struct ContactStage::Impl {
       }
     };
     if (settings.self) {
-      for (const auto& [qa, qb] : self_broad.self_pairs(patch_box)) descend(qa, qb);
+      // Patch pairs in fixed chunks on both cores; the chunks' pairs are joined in order, so the
+      // list does not depend on the threads.
+      const std::vector<std::pair<int, int>> pairs = self_broad.self_pairs(patch_box);
+      constexpr size_t kChunk = 128;
+      std::vector<std::vector<Candidate>> chunks((pairs.size() + kChunk - 1) / kChunk);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
+        std::vector<Node> stack;
+        for (size_t c = range.begin(); c != range.end(); ++c)
+          for (size_t k = c * kChunk; k < std::min(pairs.size(), (c + 1) * kChunk); ++k)
+            descend(pairs[k].first, pairs[k].second, stack, chunks[c]);
+      });
+      for (const std::vector<Candidate>& chunk : chunks) out.insert(out.end(), chunk.begin(), chunk.end());
     }
     if (!obstacle_triangles.empty()) {
       if (!obstacle_boxes_current) {  // once per step: the obstacles' motion is known for the step
