@@ -202,6 +202,15 @@ int render_saved_frames(const fs::path& dir, int width, int height) {
     }
     std::sort(files.begin(), files.end());
     if (files.empty()) throw std::runtime_error(frames.string() + ": no mesh_*.obj frames");
+    {  // Frames of the refined surface (output.obj_level > 0) are not control meshes.
+      std::ifstream first(files.front());
+      std::string comment;
+      std::getline(first, comment);
+      if (comment.find("(refined ") != std::string::npos)
+        throw std::runtime_error(files.front().string() +
+                                 ": holds the refined surface (\"output.obj_level\" > 0); clothsim render draws frames "
+                                 "written with obj_level 0 (the limit points at the control connectivity)");
+    }
     // The saved meshes are limit points at the control connectivity; they are drawn as control
     // meshes of their own subdivision surface (a slightly smoothed picture of the same surface).
     RenderSettings settings;

@@ -433,6 +433,23 @@ TEST_F(CliTest, RenderCommandRedrawsSavedFrames) {
   EXPECT_TRUE(contains(r.err, "frames")) << r.err;
 }
 
+// Frames of the refined surface (output.obj_level > 0) are refused by the render command (it
+// would subdivide an already refined surface), with a message naming the file and the key.
+TEST_F(CliTest, RenderCommandRefusesRefinedFrames) {
+  std::string text = kFallingCloth;
+  text.replace(text.find(R"("output": {"obj": true})"), std::string(R"("output": {"obj": true})").size(),
+               R"("output": {"obj": true, "obj_level": 1})");
+  const fs::path scene = write("cloth.json", text);
+  ASSERT_EQ(run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --no-render").exit_code, 0);
+  const RunResult r = run("render " + shell_quote((out_ / "cloth").string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_TRUE(contains(r.err, "mesh_0000.obj")) << r.err;
+  EXPECT_TRUE(contains(r.err, "obj_level")) << r.err;
+  int pngs = 0;
+  for (const auto& e : fs::directory_iterator(out_ / "cloth")) pngs += e.path().extension() == ".png";
+  EXPECT_EQ(pngs, 0);
+}
+
 TEST_F(CliTest, VideoOptionEncodesTheFramesWithFfmpeg) {
   if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) GTEST_SKIP() << "ffmpeg is not installed";
   const fs::path scene = write("cloth.json", kFallingCloth);
