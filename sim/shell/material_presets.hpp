@@ -1,6 +1,6 @@
 // Named shell materials for scene files ("material": {"preset": "cotton"}): the paper's cotton
 // and metal-like material, Kawabata-measured fabrics and the cloths measured by Wang et al. 2011
-// (numbers and sources in material_presets.cpp and /work/shared/reference/fabrics.md).
+// (numbers and their published sources in material_presets.cpp).
 #pragma once
 
 #include "sim/shell/material.hpp"

@@ -13,6 +13,7 @@
 // is the plane z = 0 with normal +z unless a test tilts it. Lengths [m], times [s], energies [J].
 // Each test prints the figures it measured.
 #include "sim/contact/obstacle.hpp"
+#include "sim/shell/material_presets.hpp"
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/generators.hpp"
 #include "sim/scene/scene.hpp"
@@ -45,15 +46,8 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// Cotton-like cloth: E·t = 5000 N/m, B = 1.157e-5 N·m, ν = 0.25, ρ_A = 0.1238 kg/m².
-ShellMaterial cotton() {
-  ShellMaterial m;
-  m.stretch_modulus = 5000.0;
-  m.bending_rigidity = 1.157e-5;
-  m.poisson_ratio = 0.25;
-  m.areal_density = 0.1238;
-  return m;
-}
+// The cotton preset (E·t = 5000 N/m, B = 1.157e-5 N·m, ν = 0.25, ρ_A = 0.1238 kg/m²).
+ShellMaterial cotton() { return *material_preset("cotton"); }
 
 // A dynamic problem on `mesh` with the cotton material, a direct solver, no damping, contact
 // settings at their defaults but the collision surface refined once.
