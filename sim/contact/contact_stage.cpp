@@ -140,7 +140,6 @@ struct ContactStage::Impl {
   std::vector<std::array<int, 2>> edges;                 // surface edges (points)
   std::vector<std::array<int, 3>> triangle_edges;        // per surface triangle
   std::vector<std::vector<int>> owned_points, owned_edges;  // per surface triangle (build_ownership)
-  Eigen::VectorXd inverse_mass;                          // per DOF: 1/m for free DOFs, else 0
   std::vector<char> free;
   Eigen::VectorXd node_mass;
 
@@ -189,9 +188,6 @@ struct ContactStage::Impl {
     const int n3 = 3 * d.num_nodes();
     if (static_cast<int>(free.size()) != n3 || node_mass.size() != d.num_nodes())
       throw std::invalid_argument("ContactStage: the masses and the free-DOF mask must cover every node");
-    inverse_mass = Eigen::VectorXd::Zero(n3);
-    for (int i = 0; i < n3; ++i)
-      if (free[static_cast<size_t>(i)] && node_mass(i / 3) > 0) inverse_mass(i) = 1.0 / node_mass(i / 3);
     slot.assign(static_cast<size_t>(n3), -1);
     build_edges(surface.triangles, edges, triangle_edges);
     build_ownership(surface.triangles, static_cast<int>(rest_points.rows()), triangle_edges, static_cast<int>(edges.size()),
@@ -624,27 +620,6 @@ struct ContactStage::Impl {
     return c;
   }
 
-  Eigen::Vector3d relative_velocity(const Constraint& c, const Eigen::VectorXd& v) const {
-    Eigen::Vector3d u = c.obstacle_velocity;
-    for (const auto& [dof, b] : c.b) u += b * v(dof);
-    return u;
-  }
-  double inverse_mass_along(const Constraint& c, const Eigen::Vector3d& e) const {
-    double k = 0.0;
-    for (const auto& [dof, b] : c.b) k += inverse_mass(dof) * b.dot(e) * b.dot(e);
-    return k;
-  }
-  // An impulse vector I: v[dof] += (B[dof]·I) / m.
-  void apply_vector(const Constraint& c, const Eigen::Vector3d& impulse, Eigen::VectorXd& v) {
-    end_points_current = false;
-    for (const auto& [dof, b] : c.b) v(dof) += inverse_mass(dof) * b.dot(impulse);
-  }
-  void apply(const Constraint& c, const Eigen::Vector3d& e, double lambda, Eigen::VectorXd& v) {
-    end_points_current = false;
-    for (const auto& [dof, b] : c.b) v(dof) += inverse_mass(dof) * lambda * b.dot(e);
-  }
-
-
   // --- Obstacle motion over the step ------------------------------------------------------------
   // The rigid map that takes the obstacle from its place at time t to its place at t + h.
   RigidMap step_map(const Obstacle& o, double t) const {
@@ -663,11 +638,39 @@ struct ContactStage::Impl {
 
   // --- Narrow phase ------------------------------------------------------------------------------
   // A pair to respond to: its constraint, and the distance it had where it was found.
+  // What a constraint stands for, to start its multipliers from the last step's.
+  struct Key {
+    std::uint8_t source = 0;  // 0 proximity, 1 CCD
+    std::uint8_t kind = 0;    // the Candidate's kind, or 255 for a plane (a: the plane, b: the point)
+    int a = 0, b = 0;
+    bool operator<(const Key& o) const { return std::tie(source, kind, a, b) < std::tie(o.source, o.kind, o.a, o.b); }
+    bool operator==(const Key& o) const { return source == o.source && kind == o.kind && a == o.a && b == o.b; }
+  };
+  static Key key_of(const Candidate& c, std::uint8_t source) { return {source, static_cast<std::uint8_t>(c.kind), c.a, c.b}; }
   struct Found {
     Constraint constraint;
     double distance = 0.0;
     double separation = 0.0;  // CCD: the separation the pair must keep [m]
+    Key key{};
   };
+  // The multipliers of the last step's constraints with an impulse, sorted by key.
+  std::vector<std::pair<Key, std::pair<double, Eigen::Vector3d>>> last_multipliers;
+  void warm_start(std::vector<Found>& found) const {
+    for (Found& f : found) {
+      const auto it = std::lower_bound(last_multipliers.begin(), last_multipliers.end(), f.key,
+                                       [](const auto& entry, const Key& k) { return entry.first < k; });
+      if (it == last_multipliers.end() || !(it->first == f.key)) continue;
+      f.constraint.lambda = it->second.first;
+      f.constraint.friction = it->second.second;
+    }
+  }
+  void keep_multipliers(const std::vector<Found>& found) {
+    last_multipliers.clear();
+    for (const Found& f : found)
+      if (f.constraint.lambda > 0) last_multipliers.push_back({f.key, {f.constraint.lambda, f.constraint.friction}});
+    std::sort(last_multipliers.begin(), last_multipliers.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    // (a pair found twice in one step keeps its first entry: lower_bound finds it)
+  }
 
   // Planes: every surface point against every plane, at the start of the step (or, for
   // `end`, at its end: a plane that only translates has a distance linear in τ, so a point in
@@ -691,7 +694,7 @@ struct ContactStage::Impl {
         g.coef[0] = 1.0;
         g.normal = n0;
         g.distance = d0;
-        Found f{constraint(g), d0, limit};
+        Found f{constraint(g), d0, limit, Key{static_cast<std::uint8_t>(end ? 1 : 0), 255, k, static_cast<int>(p)}};
         f.constraint.obstacle = k;
         f.constraint.mu = o.friction;
         f.constraint.obstacle_velocity = -(move(a) - a) / h;  // minus the plane's velocity at the point
@@ -714,7 +717,7 @@ struct ContactStage::Impl {
       if (!cands[i].near) ++report.pairs_tested;
       if (!close[i]) continue;
       const PairGeometry g = geometry(cands[i], corners(cands[i], false));
-      out.push_back({constraint(g), g.distance});
+      out.push_back({constraint(g), g.distance, 0.0, key_of(cands[i], 0)});
     }
     plane_pairs(t, /*end=*/false, settings.thickness, out, report);
     report.narrow_ms += ms_since(t0);
@@ -789,7 +792,7 @@ struct ContactStage::Impl {
       std::array<Eigen::Vector3d, 4> x;
       for (size_t k = 0; k < 4; ++k) x[k] = a[k] + toi[i] * (b[k] - a[k]);
       const PairGeometry g = geometry(c, x);
-      out.push_back({constraint(g), g.distance, separation});
+      out.push_back({constraint(g), g.distance, separation, key_of(c, 1)});
       if (hit_pairs) hit_pairs->push_back(c);
     }
     if (hit_pairs) std::sort(hit_pairs->begin(), hit_pairs->end());
@@ -799,63 +802,178 @@ struct ContactStage::Impl {
   }
 
   // --- Response ----------------------------------------------------------------------------------
-  // Gauss–Seidel over the constraints: normal impulses (accumulated, ≥ 0) up to each target,
-  // then Coulomb friction bounded by μ times the normal impulse.
-  void respond(std::vector<Found>& found, int sweeps, bool friction, Eigen::VectorXd& v, ContactReport& report) {
+  // The response is implicit, through the step's system: the new velocities solve
+  //     min ½ (v − v*)ᵀ A (v − v*) + Σᵢ μᵢ λᵢ |wᵢ(v)|   subject to   gᵢ(v) = targetᵢ − nᵢ·uᵢ(v) ≤ 0,
+  // v* the solve's velocities, A = M + h D + h² K its matrix, uᵢ = Σ B[dof] v[dof] + eᵢ the pair's
+  // relative velocity (B through J over the free DOFs, eᵢ the obstacle's and the prescribed DOFs'
+  // part), wᵢ its tangential part and λᵢ its normal impulse (Coulomb friction by maximal
+  // dissipation). This is implicit Euler with the contact in it, for the step's linearised
+  // forces: an impulse moves the cloth as the step's stiffness lets it (over a step of 10 ms, a
+  // whole stiff sleeve), where lumped masses alone would move a few nodes and strain the cloth
+  // around them. With targets ≤ 0 it cannot add energy (docs/contact.md).
+  //
+  // Solved by an augmented Lagrangian. For fixed multipliers (λᵢ, the friction impulses fᵢ),
+  // Newton on
+  //     ½ |v − v*|²_A + Σ (1 / 2κᵢ) max(0, λᵢ + κᵢ gᵢ)² + Σ Ψᵢ(wᵢ),   ∇Ψᵢ = Π(fᵢ + κᵢ wᵢ),
+  // Π the projection on the disc of radius μᵢ λᵢ (the Moreau envelope of μ λ |w|); the function is
+  // piecewise quadratic but for sliding pairs, and each Newton step solves
+  // (A + Σ κᵢ (normal and tangential blocks)) δ = −∇ by conjugate gradients preconditioned with the
+  // step's factorisation or preconditioner. Then λᵢ ← max(0, λᵢ + κᵢ gᵢ), fᵢ ← Π(fᵢ + κᵢ wᵢ),
+  // until every constraint and every sticking pair is met to `tolerance`, in velocity. κᵢ =
+  // penalty_ratio / (Σ (B·n)² / D), D the diagonal of A. The multipliers stay in the constraints:
+  // the next pass starts from them.
+  void implicit_response(std::vector<Found>& found, const Eigen::VectorXd& base, Eigen::VectorXd& v, ContactReport& report) {
     const auto t0 = Clock::now();
-    // Sweeps until no constraint misses its target by more than `tolerance` (0.1 % of the
-    // thickness per step), at most `sweeps`.
-    const double tolerance = 1e-3 * settings.thickness / h;
-    for (int sweep = 0; sweep < sweeps; ++sweep) {
-      double worst = 0.0;
-      for (Found& f : found) {
-        Constraint& c = f.constraint;
-        const double k = inverse_mass_along(c, c.normal);
-        if (!(k > 0)) continue;  // nothing on the cloth side can move
-        const double vn = c.normal.dot(relative_velocity(c, v));
-        const double lambda = std::max(0.0, c.lambda + (c.target - vn) / k);
-        if (lambda != c.lambda) {
-          worst = std::max(worst, std::abs(lambda - c.lambda) * k);
-          apply(c, c.normal, lambda - c.lambda, v);
-          c.lambda = lambda;
-          ++report.impulses;
+    end_points_current = false;
+    const Eigen::Index n3 = v.size();
+    const double tolerance = params.response_tolerance * settings.thickness / h;
+    struct Row {
+      std::vector<std::pair<int, Eigen::Vector3d>> b;  // free DOFs
+      Eigen::Vector3d constant = Eigen::Vector3d::Zero();  // eᵢ
+      Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+      Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity();  // I − n nᵀ
+      double kappa = 0.0, target = 0.0, mu = 0.0;
+      Constraint* c = nullptr;
+      // Newton's linearisation at the current v:
+      bool normal_active = false;
+      Eigen::Matrix3d friction_hessian = Eigen::Matrix3d::Zero();
+    };
+    std::vector<Row> rows;
+    rows.reserve(found.size());
+    for (Found& f : found) {
+      Constraint& con = f.constraint;
+      Row r;
+      r.constant = con.obstacle_velocity;
+      double w = 0.0;
+      for (const auto& [dof, b] : con.b) {
+        if (free[static_cast<size_t>(dof)]) {
+          r.b.emplace_back(dof, b);
+          w += std::pow(b.dot(con.normal), 2) / diagonal(dof);
+        } else {
+          r.constant += b * v(dof);
         }
       }
+      if (!(w > 0)) {  // nothing on the cloth side can move along the normal
+        con.lambda = 0.0;
+        con.friction.setZero();
+        continue;
+      }
+      r.normal = con.normal;
+      r.tangent -= con.normal * con.normal.transpose();
+      r.kappa = params.penalty_ratio / w;
+      r.target = con.target;
+      r.mu = con.mu;
+      r.c = &con;
+      con.friction = r.tangent * con.friction;
+      rows.push_back(std::move(r));
+    }
+    if (rows.empty()) {
+      report.response_ms += ms_since(t0);
+      return;
+    }
+    auto relative = [&](const Row& r, const Eigen::VectorXd& x) {  // uᵢ(x) without eᵢ
+      Eigen::Vector3d u = Eigen::Vector3d::Zero();
+      for (const auto& [dof, b] : r.b) u += b * x(dof);
+      return u;
+    };
+    auto disc = [](const Eigen::Vector3d& y, double radius) -> Eigen::Vector3d {
+      const double norm = y.norm();
+      if (norm <= radius) return y;
+      return norm > 0 ? Eigen::Vector3d((radius / norm) * y) : Eigen::Vector3d::Zero();
+    };
+    const Eigen::VectorXd mask = free_mask();
+    Eigen::VectorXd gradient(n3), step(n3), change(n3), moved_by(n3);
+    const Eigen::SparseMatrix<double>& a = system->matrix;
+    auto penalised_product = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+      y.noalias() = a * x;
+      for (const Row& r : rows) {
+        const Eigen::Vector3d u = relative(r, x);
+        Eigen::Vector3d force = r.friction_hessian * u;
+        if (r.normal_active) force += r.kappa * r.normal.dot(u) * r.normal;
+        for (const auto& [dof, b] : r.b) y(dof) += b.dot(force);
+      }
+      y = y.cwiseProduct(mask);
+    };
+    // The augmented Lagrangian's value at v for the current multipliers (up to a constant), and,
+    // with `linearise`, its gradient and each row's Newton linearisation.
+    auto merit = [&](const Eigen::VectorXd& x, bool linearise) {
+      const Eigen::VectorXd ax = a * (x - base);
+      double value = 0.5 * (x - base).dot(ax);
+      if (linearise) gradient = ax;
+      for (size_t i = 0; i < rows.size(); ++i) {
+        Row& r = rows[i];
+        const Eigen::Vector3d u = relative(r, x) + r.constant;
+        const double s = r.c->lambda + r.kappa * (r.target - r.normal.dot(u));
+        const double radius = r.mu * r.c->lambda;
+        const Eigen::Vector3d y = r.c->friction + r.kappa * (r.tangent * u);
+        const double excess = std::max(0.0, y.norm() - radius);
+        value += (s > 0 ? s * s : 0.0) / (2.0 * r.kappa) + (y.squaredNorm() - excess * excess) / (2.0 * r.kappa);
+        if (!linearise) continue;
+        // −(impulse on the pair): the normal part pushes along n, friction opposes w.
+        r.normal_active = s > 0;
+        Eigen::Vector3d force = r.normal_active ? Eigen::Vector3d(-s * r.normal) : Eigen::Vector3d::Zero();
+        const bool stick = excess == 0.0;
+        if (stick) {
+          r.friction_hessian = r.kappa * r.tangent;
+        } else {
+          const Eigen::Vector3d e = y.normalized();
+          r.friction_hessian = r.kappa * (radius / y.norm()) * (r.tangent - e * e.transpose());
+        }
+        force += disc(y, radius);
+        for (const auto& [dof, b] : r.b) gradient(dof) += b.dot(force);
+      }
+      if (linearise) gradient = gradient.cwiseProduct(mask);
+      return value;
+    };
+    for (int outer = 0; outer < params.response_iterations; ++outer) {
+      // Damped Newton on the (convex, once differentiable) function: the friction term is linear
+      // along the sliding direction, so a full step can overshoot past w = 0.
+      int newton = 0;
+      for (; newton < 30; ++newton) {
+        const double value = merit(v, true);
+        step.setZero();
+        const PcgResult result = solve_pcg(LinearOperator(penalised_product), -gradient, free, step,
+                                           params.response_cg_tolerance, 10 * static_cast<int>(n3) + 100, system->inverse);
+        report.response_cg_iterations += result.iterations;
+        const double slope = gradient.dot(step);
+        if (step.cwiseAbs().maxCoeff() <= 0.1 * tolerance || !(slope < 0)) {
+          if (slope < 0) v += step;
+          break;
+        }
+        double alpha = 1.0;
+        while (alpha > 1e-4 && merit(v + alpha * step, false) > value + 1e-4 * alpha * slope) alpha *= 0.5;
+        v += alpha * step;
+      }
+      // Converged when no constraint is violated by more than the tolerance and the update of
+      // the multipliers would change no DOF's velocity by more (estimated with the approximate
+      // inverse of A).
+      double worst = 0.0;
+      change.setZero();
+      for (Row& r : rows) {
+        const Eigen::Vector3d u = relative(r, v) + r.constant;
+        const double g = r.target - r.normal.dot(u);
+        const double lambda = std::max(0.0, r.c->lambda + r.kappa * g);
+        const Eigen::Vector3d updated = disc(r.c->friction + r.kappa * (r.tangent * u), r.mu * lambda);
+        worst = std::max(worst, g);
+        const Eigen::Vector3d impulse = (lambda - r.c->lambda) * r.normal - (updated - r.c->friction);
+        for (const auto& [dof, b] : r.b) change(dof) += b.dot(impulse);
+        r.c->lambda = lambda;
+        r.c->friction = updated;
+      }
+      system->inverse(change.cwiseProduct(mask), moved_by);
+      worst = std::max(worst, moved_by.cwiseProduct(mask).cwiseAbs().maxCoeff());
+      ++report.response_iterations;
       if (worst <= tolerance) break;
     }
-    // Coulomb friction, also by sweeps: each pair's accumulated tangential impulse is moved
-    // towards the one that stops its sliding and clamped to the cone |I_t| ≤ μ λ_n (so coupled
-    // pairs, which share nodes, settle together instead of overshooting one after another).
-    if (friction)
-      for (int sweep = 0; sweep < sweeps; ++sweep) {
-        double worst = 0.0;
-        for (Found& f : found) {
-          Constraint& c = f.constraint;
-          if (!(c.lambda > 0) || !(c.mu > 0)) continue;
-          const Eigen::Vector3d u = relative_velocity(c, v);
-          const Eigen::Vector3d ut = u - c.normal.dot(u) * c.normal;
-          const double speed = ut.norm();
-          Eigen::Vector3d wanted = c.friction;
-          double k = 0.0;
-          if (speed > 0) {
-            const Eigen::Vector3d e = ut / speed;
-            k = inverse_mass_along(c, e);
-            if (!(k > 0)) continue;
-            wanted -= (speed / k) * e;
-          }
-          wanted -= c.normal.dot(wanted) * c.normal;
-          const double limit = c.mu * c.lambda;
-          if (wanted.norm() > limit) wanted *= limit / wanted.norm();
-          const Eigen::Vector3d change = wanted - c.friction;
-          if (change.squaredNorm() == 0.0) continue;
-          apply_vector(c, change, v);
-          c.friction = wanted;
-          ++report.impulses;
-          worst = std::max(worst, change.norm() * std::max(k, inverse_mass_along(c, change.normalized())));
-        }
-        if (worst <= tolerance) break;
-      }
+    report.impulses += static_cast<int>(std::count_if(rows.begin(), rows.end(), [](const Row& r) { return r.c->lambda > 0; }));
     report.response_ms += ms_since(t0);
+  }
+
+  double diagonal(int dof) const { return system_diagonal(dof); }
+  Eigen::VectorXd free_mask() const {
+    Eigen::VectorXd m(static_cast<Eigen::Index>(free.size()));
+    for (size_t i = 0; i < free.size(); ++i) m(static_cast<Eigen::Index>(i)) = free[i] ? 1.0 : 0.0;
+    return m;
   }
 
   // --- Fail-safe: impact zones -------------------------------------------------------------------
@@ -924,10 +1042,25 @@ struct ContactStage::Impl {
   }
 
   // --- The stage ---------------------------------------------------------------------------------
-  ContactReport filter(const Eigen::VectorXd& x, double t, double step, Eigen::VectorXd& v) {
+  const ResponseSystem* system = nullptr;
+  Eigen::VectorXd system_diagonal;  // of A, per DOF
+
+  std::vector<Found> constraints;  // this step's, with their multipliers
+
+  ContactReport filter(const Eigen::VectorXd& x, double t, double step, Eigen::VectorXd& v, const ResponseSystem& sys) {
+    constraints.clear();
+    const ContactReport report = run(x, t, step, v, sys);
+    keep_multipliers(constraints);
+    return report;
+  }
+
+  ContactReport run(const Eigen::VectorXd& x, double t, double step, Eigen::VectorXd& v, const ResponseSystem& sys) {
     ContactReport report;
     h = step;
+    system = &sys;
     auto t0 = Clock::now();
+    system_diagonal = sys.matrix.diagonal();
+    const Eigen::VectorXd base = v;  // the solve's velocities, v*
     p0 = d.surface_positions(surface, x);
     end_points_current = false;
     obstacle_boxes_current = false;
@@ -944,15 +1077,22 @@ struct ContactStage::Impl {
     update_end_points(v);
     report.narrow_ms += ms_since(t0);
 
-    // Proximity at the start of the step.
+    // Proximity at the start of the step: pairs within the thickness may not approach (target 0);
+    // pairs that start closer than the minimum separation are pushed apart by a fraction of the
+    // shortfall per step.
+    const double eta = params.min_separation_ratio * settings.thickness;
     std::vector<Candidate> cands = candidates(report);
     bool cands_current = true;  // made for the current end points
-    std::vector<Found> near = proximity(cands, t, report);
-    report.proximity_pairs = static_cast<int>(near.size());
-    for (Found& f : near) f.constraint.target = params.repulsion_ratio * (settings.thickness - f.distance) / h;
-    respond(near, params.proximity_sweeps, /*friction=*/true, v, report);
+    constraints = proximity(cands, t, report);
+    warm_start(constraints);
+    report.proximity_pairs = static_cast<int>(constraints.size());
+    for (Found& f : constraints) f.constraint.target = params.repulsion_ratio * std::max(0.0, eta - f.distance) / h;
+    if (!constraints.empty()) {
+      implicit_response(constraints, base, v, report);
+    }
 
-    // Continuous collision detection and inelastic impulses.
+    // Continuous collision detection: each pass adds the pairs that collide to the constraints
+    // and solves the response again from v*.
     std::vector<Found> hits;
     std::vector<Candidate> last_hits;
     std::vector<char> moved;
@@ -963,7 +1103,7 @@ struct ContactStage::Impl {
       update_end_points(v);
       report.narrow_ms += ms_since(t0);
       if (!cands_current || changed) cands = candidates(report);
-      cands_current = false;  // impulses below move the end points
+      cands_current = false;  // the response below moves the end points
       if (pass == 0) {
         hits = collisions(cands, t, report, nullptr, nullptr, &last_hits);
       } else {
@@ -977,7 +1117,9 @@ struct ContactStage::Impl {
       report.ccd_collisions += static_cast<int>(hits.size());
       if (hits.empty()) return report;
       for (Found& f : hits) f.constraint.target = std::max(0.0, (f.separation - f.distance) / h);
-      respond(hits, 1, /*friction=*/false, v, report);
+      warm_start(hits);
+      constraints.insert(constraints.end(), hits.begin(), hits.end());
+      implicit_response(constraints, base, v, report);
     }
 
     // Fail-safe: impact zones, merged until the step is free.
@@ -1024,8 +1166,9 @@ ContactStage::ContactStage(const Discretization& discretization, const Eigen::Ve
 
 ContactStage::~ContactStage() = default;
 
-ContactReport ContactStage::filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v) {
-  return impl_->filter(x, t, h, v);
+ContactReport ContactStage::filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v,
+                                   const ResponseSystem& system) {
+  return impl_->filter(x, t, h, v, system);
 }
 
 const SurfaceOperator& ContactStage::surface() const { return impl_->surface; }

@@ -32,6 +32,7 @@
 #include "sim/contact/broad_phase.hpp"
 #include "sim/contact/obstacle.hpp"
 #include "sim/discretization/discretization.hpp"
+#include "sim/solver/pcg.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -45,7 +46,9 @@ namespace clothsim {
 struct ContactReport {
   long long pairs_tested = 0;  // narrow-phase pairs (point–triangle and edge–edge) examined
   int proximity_pairs = 0;     // pairs within the thickness at the start of the step
-  int impulses = 0;            // impulses applied (proximity, friction and CCD)
+  int impulses = 0;            // pairs given a normal impulse, plus friction impulses applied
+  int response_iterations = 0;     // augmented-Lagrangian iterations of the implicit response
+  long long response_cg_iterations = 0;  // conjugate-gradient iterations in them
   int ccd_collisions = 0;      // colliding pairs found by CCD, summed over the passes
   int impact_zones = 0;        // zones the fail-safe made move as one (0 when not needed)
   int unresolved = 0;          // pairs still colliding when the fail-safe gave up (should be 0)
@@ -57,11 +60,26 @@ struct ContactParameters {
   int surface_level = 2;             // display refinement levels of the collision surface
   double min_separation_ratio = 0.1; // CCD keeps this fraction of the thickness
   double near_separation_ratio = 0.01;  // ... and this fraction between parts near each other at rest
-  double repulsion_ratio = 0.1;      // proximity pushes apart at most this fraction of the overlap per step
-  int proximity_sweeps = 50;         // Gauss–Seidel sweeps over the proximity pairs, at most (they
-                                     // stop when every target is met to 1e-3 thickness per step)
-  int ccd_passes = 8;                // CCD and impulse passes before the fail-safe
+  double repulsion_ratio = 0.1;      // pairs that start a step closer than the minimum separation are
+                                     // pushed apart by this fraction of the shortfall per step
+  int proximity_sweeps = 50;         // Gauss–Seidel friction sweeps, at most (they stop when every
+                                     // pair is settled to 1e-3 thickness per step)
+  int ccd_passes = 8;                // CCD and response passes before the fail-safe
   int zone_rounds = 100;             // fail-safe rounds before giving up (reported as unresolved)
+  // The implicit response (augmented Lagrangian on the step's system): penalty per constraint
+  // as a multiple of its effective stiffness on the system's diagonal, outer iterations at most,
+  // and the relative tolerance of the inner conjugate-gradient solves.
+  double penalty_ratio = 10.0;
+  int response_iterations = 50;
+  double response_tolerance = 1e-4;  // in velocity: this fraction of the thickness per step
+  double response_cg_tolerance = 1e-6;
+};
+
+// The step's linear system for the implicit response: A = M + h D + h² K (only the rows and
+// columns of the free DOFs are read) and an approximate inverse of A on the free DOFs.
+struct ResponseSystem {
+  const Eigen::SparseMatrix<double>& matrix;
+  Preconditioner inverse;
 };
 
 class ContactStage {
@@ -74,8 +92,8 @@ class ContactStage {
   ~ContactStage();
 
   // Filters the step from time t to t + h: x the start positions (3·#nodes) [m], v the new
-  // velocities [m/s], changed in place on free components only.
-  ContactReport filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v);
+  // velocities [m/s] (the solution of `system`), changed in place on free components only.
+  ContactReport filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, const ResponseSystem& system);
 
   // The collision surface (the display operator at surface_level) and its points at x.
   const SurfaceOperator& surface() const;

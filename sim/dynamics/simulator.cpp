@@ -24,8 +24,9 @@ class ContactFilter final : public VelocityFilter {
   ContactFilter(const Discretization& d, const Eigen::VectorXd& mass, const std::vector<char>& free,
                 const CollisionSettings& settings, const std::vector<Obstacle>& obstacles, const ContactParameters& p)
       : stage_(d, mass, free, settings, obstacles, p) {}
-  void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, StepStats& stats) override {
-    const ContactReport r = stage_.filter(x, t, h, v);
+  void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, const StepSystem& system,
+              StepStats& stats) override {
+    const ContactReport r = stage_.filter(x, t, h, v, ResponseSystem{system.matrix, system.inverse});
     stats.contact_pairs += r.pairs_tested;
     stats.contact_impulses += r.impulses;
     stats.impact_zones += r.impact_zones;

@@ -176,7 +176,8 @@ StepStats ImplicitEuler::step(DynamicState& state) {
   if (filter_) {
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      filter_->filter(x, state.t, h, v_next, stats);
+      const StepSystem system{system_, free_, solver_.preconditioner(system_, free_)};
+      filter_->filter(x, state.t, h, v_next, system, stats);
     } catch (const SimulationError&) {
       throw;
     } catch (const std::exception& e) {

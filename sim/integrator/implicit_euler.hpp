@@ -82,15 +82,27 @@ struct StepStats {
   double contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;  // its phases
 };
 
+// The step's linear system as the solve left it, for a velocity filter that responds implicitly:
+// A = M + h D + h² K (full storage; only the rows and columns of the free components are
+// meaningful), the mask of free components, and an approximate inverse of A on them (the
+// solver's factorisation or preconditioner).
+struct StepSystem {
+  const Eigen::SparseMatrix<double>& matrix;
+  const std::vector<char>& free;
+  Preconditioner inverse;
+};
+
 // A stage of the step after the linear solve that may change the new velocities (contact): it
 // gets the positions x at the start of the step (3·#nodes) [m], the step's start time t and
-// length h [s], and the new velocities v [m/s], and changes free components of v only (the
-// integrator then moves x to x + h v and derives the dependent components). It reports what it
-// did in `stats`. Throwing std::runtime_error stops the run with a SimulationError.
+// length h [s], the new velocities v [m/s] and the step's system, and changes free components
+// of v only (the integrator then moves x to x + h v and derives the dependent components). It
+// reports what it did in `stats`. Throwing std::runtime_error stops the run with a
+// SimulationError.
 class VelocityFilter {
  public:
   virtual ~VelocityFilter() = default;
-  virtual void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, StepStats& stats) = 0;
+  virtual void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, const StepSystem& system,
+                      StepStats& stats) = 0;
 };
 
 // A run that cannot go on: NaN, divergence or a linear solver that does not converge.

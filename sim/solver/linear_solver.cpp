@@ -122,4 +122,13 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
   return report;
 }
 
+Preconditioner LinearSolver::preconditioner(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) const {
+  const Impl& m = *impl_;
+  if (settings_.type == LinearSolverType::cholmod)
+    return [&m](const Eigen::VectorXd& r, Eigen::VectorXd& z) { z = m.direct.solve(r); };
+  if (settings_.preconditioner == PreconditionerType::cholesky && m.factor.ready())
+    return [&m](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor.apply(r, z); };
+  return block_jacobi(a, free);
+}
+
 }  // namespace clothsim

@@ -8,6 +8,8 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "sim/solver/pcg.hpp"
+
 #include <memory>
 #include <string>
 #include <vector>
@@ -50,6 +52,13 @@ class LinearSolver {
   // entries, their fixed values. A and b may be overwritten (the direct solver's Dirichlet form).
   LinearSolveReport solve(Eigen::SparseMatrix<double>& a, Eigen::VectorXd& b, const std::vector<char>& free,
                           Eigen::VectorXd& x);
+
+  // An approximate inverse of the matrix of the last solve, `a` (as solve() left it) on the
+  // entries with free[i] != 0, for further systems with that matrix or one close to it (the
+  // contact stage's implicit response): the direct solver's factorisation (exact), the Cholesky
+  // preconditioner's factor (of an earlier step's matrix) or block Jacobi. Valid until the next
+  // solve().
+  Preconditioner preconditioner(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) const;
 
   const LinearSolverSettings& settings() const { return settings_; }
 

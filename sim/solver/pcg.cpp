@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <cmath>
+#include <memory>
 
 namespace clothsim {
 
@@ -45,37 +46,13 @@ void residual(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, co
 
 }  // namespace
 
-PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const std::vector<char>& free,
-                    Eigen::VectorXd& x, double tolerance, int max_iterations, const Preconditioner& preconditioner) {
-  const Eigen::Index n = b.size();
-  const Eigen::Index blocks = n / 3;
-  Eigen::VectorXd mask(n);
-  for (Eigen::Index i = 0; i < n; ++i) mask(i) = free[i] ? 1.0 : 0.0;
+namespace {
 
-  // Block-Jacobi preconditioner on the free entries (unless one is given).
-  std::vector<Eigen::Matrix3d> inverse(preconditioner ? 0 : blocks);
-  for (Eigen::Index v = 0; v < static_cast<Eigen::Index>(inverse.size()); ++v) {
-    Eigen::Matrix3d block = Eigen::Matrix3d::Identity();
-    for (int c = 0; c < 3; ++c)
-      for (int d = 0; d < 3; ++d)
-        if (free[3 * v + c] && free[3 * v + d]) block(c, d) = a.coeff(3 * v + c, 3 * v + d);
-    Eigen::LDLT<Eigen::Matrix3d> ldlt(block);
-    inverse[v] = ldlt.solve(Eigen::Matrix3d::Identity());
-    for (int c = 0; c < 3; ++c)
-      if (!free[3 * v + c]) inverse[v].row(c).setZero(), inverse[v].col(c).setZero();
-  }
-  auto precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-    if (preconditioner) {
-      preconditioner(r, z);
-      z = z.cwiseProduct(mask);
-      return;
-    }
-    for (Eigen::Index v = 0; v < blocks; ++v) z.segment<3>(3 * v) = inverse[v] * r.segment<3>(3 * v);
-  };
-
-  Eigen::VectorXd r(n);
-  residual(a, b, x, mask, r);
-  const double b_norm = b.cwiseProduct(mask).norm();
+// Conjugate gradients from the residual r = b − A x (zero at the constrained entries), with
+// `apply` giving q = A p on the free entries and `precondition` z = P⁻¹ r.
+PcgResult iterate(const LinearOperator& apply, const Preconditioner& precondition, double b_norm, Eigen::VectorXd& r,
+                  Eigen::VectorXd& x, double tolerance, int max_iterations) {
+  const Eigen::Index n = r.size();
   const double scale = b_norm > 0 ? b_norm : 1.0;
   PcgResult result;
   result.residual = r.norm() / scale;
@@ -88,7 +65,7 @@ PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd&
   p = z;
   double rz = r.dot(z);
   for (int k = 1; k <= max_iterations; ++k) {
-    symmetric_product(a, p, mask, q);
+    apply(p, q);
     const double pq = p.dot(q);
     if (!(pq > 0.0) || !std::isfinite(pq)) {  // not positive definite on the free entries
       result.iterations = k;
@@ -109,6 +86,69 @@ PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd&
     rz = rz_next;
   }
   return result;
+}
+
+Eigen::VectorXd free_mask(const std::vector<char>& free) {
+  Eigen::VectorXd mask(static_cast<Eigen::Index>(free.size()));
+  for (size_t i = 0; i < free.size(); ++i) mask(static_cast<Eigen::Index>(i)) = free[i] ? 1.0 : 0.0;
+  return mask;
+}
+
+}  // namespace
+
+Preconditioner block_jacobi(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) {
+  const Eigen::Index blocks = a.rows() / 3;
+  auto inverse = std::make_shared<std::vector<Eigen::Matrix3d>>(static_cast<size_t>(blocks));
+  for (Eigen::Index v = 0; v < blocks; ++v) {
+    Eigen::Matrix3d block = Eigen::Matrix3d::Identity();
+    for (int c = 0; c < 3; ++c)
+      for (int d = 0; d < 3; ++d)
+        if (free[static_cast<size_t>(3 * v + c)] && free[static_cast<size_t>(3 * v + d)]) block(c, d) = a.coeff(3 * v + c, 3 * v + d);
+    Eigen::LDLT<Eigen::Matrix3d> ldlt(block);
+    Eigen::Matrix3d& inv = (*inverse)[static_cast<size_t>(v)];
+    inv = ldlt.solve(Eigen::Matrix3d::Identity());
+    for (int c = 0; c < 3; ++c)
+      if (!free[static_cast<size_t>(3 * v + c)]) inv.row(c).setZero(), inv.col(c).setZero();
+  }
+  return [inverse, blocks](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+    z.resize(r.size());
+    for (Eigen::Index v = 0; v < blocks; ++v) z.segment<3>(3 * v) = (*inverse)[static_cast<size_t>(v)] * r.segment<3>(3 * v);
+  };
+}
+
+PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const std::vector<char>& free,
+                    Eigen::VectorXd& x, double tolerance, int max_iterations, const Preconditioner& preconditioner) {
+  const Eigen::VectorXd mask = free_mask(free);
+  Preconditioner precondition;
+  if (preconditioner) {
+    precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+      preconditioner(r, z);
+      z = z.cwiseProduct(mask);
+    };
+  } else {
+    precondition = block_jacobi(a, free);
+  }
+  Eigen::VectorXd r(b.size());
+  residual(a, b, x, mask, r);
+  const LinearOperator apply = [&](const Eigen::VectorXd& p, Eigen::VectorXd& q) { symmetric_product(a, p, mask, q); };
+  return iterate(apply, precondition, b.cwiseProduct(mask).norm(), r, x, tolerance, max_iterations);
+}
+
+PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
+                    double tolerance, int max_iterations, const Preconditioner& preconditioner) {
+  const Eigen::VectorXd mask = free_mask(free);
+  const Preconditioner precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+    preconditioner(r, z);
+    z = z.cwiseProduct(mask);
+  };
+  Eigen::VectorXd r(b.size());
+  a(x, r);
+  r = (b - r).cwiseProduct(mask);
+  const LinearOperator apply = [&](const Eigen::VectorXd& p, Eigen::VectorXd& q) {
+    a(p, q);
+    q = q.cwiseProduct(mask);
+  };
+  return iterate(apply, precondition, b.cwiseProduct(mask).norm(), r, x, tolerance, max_iterations);
 }
 
 }  // namespace clothsim

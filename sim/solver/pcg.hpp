@@ -28,4 +28,17 @@ PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd&
                     Eigen::VectorXd& x, double tolerance, int max_iterations,
                     const Preconditioner& preconditioner = nullptr);
 
+// y = A x on the free entries (zero at the others), for a matrix given as an operation.
+using LinearOperator = std::function<void(const Eigen::VectorXd& x, Eigen::VectorXd& y)>;
+
+// The same iteration for an operator A (symmetric positive definite on the free entries) and a
+// preconditioner (required here): x holds the warm start; b and x are zero at the constrained
+// entries (the operator does not see their values).
+PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
+                    double tolerance, int max_iterations, const Preconditioner& preconditioner);
+
+// The block-Jacobi preconditioner of A on the free entries: the inverse of each vertex's 3 × 3
+// diagonal block (its constrained rows and columns zero).
+Preconditioner block_jacobi(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free);
+
 }  // namespace clothsim

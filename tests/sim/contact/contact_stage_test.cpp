@@ -461,18 +461,17 @@ TEST(ContactPlane, FlatLandingStaysFlat) {
   EXPECT_LE(run.most_elastic, 1e-6 * run.drop_energy()) << "at step " << run.most_elastic_step;
 }
 
-// KNOWN DEFECT (issue 14, open): disabled until the contact stage spreads its impulses through
-// the implicit system's response instead of the lumped mass alone. Measured at the time of
-// disabling: largest rise 6.1e-8 J against a bound of 3.6e-14 J (the repulsion lifts the cloth out of the thickness layer). The test stays as the acceptance check for that fix.
-TEST(ContactEnergy, DISABLED_DroppedClothNeverGainsMechanicalEnergy) {
-  // Kinetic + elastic + gravitational potential energy never rises from one step to the next by
-  // more than 1e-9 of the drop energy m g (3 mm): contact is inelastic and the ground does no
-  // work; implicit Euler only dissipates.
+TEST(ContactEnergy, DroppedClothNeverGainsMechanicalEnergy) {
+  // Kinetic + elastic + gravitational potential energy never rises from one step to the next:
+  // contact is inelastic and the ground does no work; implicit Euler only dissipates. What is
+  // allowed is the contact solver's tolerance (1e-4 thickness per step in velocity): measured,
+  // the largest rise is 7.4e-12 / 6.9e-13 / 8.5e-14 J at tolerances 1e-3 / 1e-4 / 1e-5, i.e. it
+  // goes to zero with the tolerance. Bound: 1e-7 of the drop energy (3.6e-12 J).
   const DropRun run = drop_on_ground(0.5);
   std::printf("dropped cloth: largest rise of the mechanical energy in a step %.2e J (%.1e of the drop energy %.2e J, step "
               "%d)\n",
               run.largest_rise, run.largest_rise / run.drop_energy(), run.drop_energy(), run.rise_step);
-  EXPECT_LE(run.largest_rise, 1e-9 * run.drop_energy()) << "at step " << run.rise_step;
+  EXPECT_LE(run.largest_rise, 1e-7 * run.drop_energy()) << "at step " << run.rise_step;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -528,10 +527,9 @@ TEST(ContactFriction, PatchSticksBelowTheFrictionAngle) {
 
 TEST(ContactFriction, PatchSlidesAboveTheFrictionAngleWithCoulombDeceleration) {
   // tan 30° = 0.577 > μ = 0.2: the patch slides with a = g (sin θ − μ cos θ) = 3.206 m/s².
-  // Expected distance ½ a T². Tolerance 10 %: friction acts only on the points found within the
-  // thickness at the start of a step, and their normal impulse also carries the repulsion (up to
-  // 10 % of the overlap per step), so the friction force fluctuates around μ m g cos θ from step
-  // to step; implicit Euler's own error is (n + 1)/n − 1 = 0.3 % for n = 300 steps.
+  // Expected distance ½ a T². Tolerance 2 %: implicit Euler's own error is (n + 1)/n − 1 = 0.3 %
+  // for n = 300 steps, and the contact solver's tolerance (1e-4 thickness per step) moves the
+  // friction impulse by far less.
   const auto t0 = std::chrono::steady_clock::now();
   const double theta = 30.0 * kPi / 180.0, mu = 0.2, duration = 0.3;
   const SlopeRun run = slide(30.0, mu, duration);
@@ -541,15 +539,12 @@ TEST(ContactFriction, PatchSlidesAboveTheFrictionAngleWithCoulombDeceleration) {
               "%.1e across; lowest point %.2e m; %.2f s\n",
               duration, run.along, expected, 100.0 * (run.along / expected - 1.0), frictionless, run.across, run.lowest,
               seconds_since(t0));
-  EXPECT_NEAR(run.along, expected, 0.10 * expected);
+  EXPECT_NEAR(run.along, expected, 0.02 * expected);
   EXPECT_LT(run.across, 1e-3);
   EXPECT_GE(run.lowest, 0.1e-3 - 1e-12);
 }
 
-// KNOWN DEFECT (issue 14, open): disabled until the contact stage spreads its impulses through
-// the implicit system's response instead of the lumped mass alone. Measured at the time of
-// disabling: elastic energy 1.3e-8 J against a bound of 3.6e-11 J (friction impulses on nodes shared by several contact points leave in-plane strain). The test stays as the acceptance check for that fix.
-TEST(ContactFriction, DISABLED_FlatClothRestingWithFrictionStaysUnstrained) {
+TEST(ContactFriction, FlatClothRestingWithFrictionStaysUnstrained) {
   // The flat landing of ContactPlane.FlatLandingStaysFlat on ground with μ = 0.5: nothing moves
   // along the plane, so friction has nothing to resist and the exact motion stays unstrained.
   // Allowed: elastic energy below 1e-6 of the drop energy at every step.
@@ -685,10 +680,7 @@ TEST(ContactMomentum, CollidingClothPartsKeepTheirTotalMomentum) {
   EXPECT_EQ(run.self_pairs, 0);
 }
 
-// KNOWN DEFECT (issue 14, open): disabled until the contact stage spreads its impulses through
-// the implicit system's response instead of the lumped mass alone. Measured at the time of
-// disabling: +4.7e-5 J (65 % of the energy before contact) at the contact step: kinetic energy falls by 2.2e-6 J, elastic energy rises by 4.9e-5 J. The test stays as the acceptance check for that fix.
-TEST(ContactEnergy, DISABLED_CollidingClothPartsNeverGainEnergy) {
+TEST(ContactEnergy, CollidingClothPartsNeverGainEnergy) {
   // After the push, kinetic + elastic energy is constant in free flight and can only fall in an
   // inelastic collision (implicit Euler dissipates too): it never rises from one step to the next
   // by more than 1e-9 of the energy before contact, and ends below it.
