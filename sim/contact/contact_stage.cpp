@@ -925,6 +925,7 @@ struct ContactStage::Impl {
       if (linearise) gradient = gradient.cwiseProduct(mask);
       return value;
     };
+    Eigen::VectorXd v_outer = v;
     for (int outer = 0; outer < params.response_iterations; ++outer) {
       // Damped Newton on the (convex, once differentiable) function: the friction term is linear
       // along the sliding direction, so a full step can overshoot past w = 0.
@@ -961,7 +962,13 @@ struct ContactStage::Impl {
         r.c->friction = updated;
       }
       system->inverse(change.cwiseProduct(mask), moved_by);
-      worst = std::max(worst, moved_by.cwiseProduct(mask).cwiseAbs().maxCoeff());
+      const double moves = moved_by.cwiseProduct(mask).cwiseAbs().maxCoeff();
+      // (Multipliers can also change without moving anything: pairs that push on the same points
+      // from two sides. Then the velocities have settled: they changed by less than the tolerance
+      // over the last update.)
+      const double settled = (v - v_outer).cwiseProduct(mask).cwiseAbs().maxCoeff();
+      v_outer = v;
+      worst = std::max(worst, outer > 0 ? std::min(moves, settled) : moves);
       ++report.response_iterations;
       if (worst <= tolerance) break;
     }

@@ -70,7 +70,7 @@ struct ContactParameters {
   // as a multiple of its effective stiffness on the system's diagonal, outer iterations at most,
   // and the relative tolerance of the inner conjugate-gradient solves.
   double penalty_ratio = 10.0;
-  int response_iterations = 50;
+  int response_iterations = 10;
   double response_tolerance = 1e-4;  // in velocity: this fraction of the thickness per step
   double response_cg_tolerance = 1e-6;
 };
