@@ -148,6 +148,7 @@ struct RunTotals {
   int frames = 0;
   int max_solver_iterations = 0;
   long long contact_pairs = 0, contact_impulses = 0, impact_zones = 0, contact_unresolved = 0;
+  long long contact_response_iterations = 0, contact_cg_iterations = 0;
   double contact_ms = 0.0, contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;
 };
 
@@ -175,7 +176,9 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                     {"seconds", totals.contact_ms / 1000.0},
                     {"broad_phase_seconds", totals.contact_broad_ms / 1000.0},
                     {"narrow_phase_seconds", totals.contact_narrow_ms / 1000.0},
-                    {"response_seconds", totals.contact_response_ms / 1000.0}};
+                    {"response_seconds", totals.contact_response_ms / 1000.0},
+                    {"response_iterations", totals.contact_response_iterations},
+                    {"response_cg_iterations", totals.contact_cg_iterations}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -188,7 +191,7 @@ class Outputs {
       : scene_(scene), dir_(dir), images_(images), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms") +
-                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms" : ""));
+                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations" : ""));
     probes_.flush();
     stats_.flush();
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
@@ -257,7 +260,8 @@ class Outputs {
     if (scene_.problem.has_contact())
       for (const std::string& field : {std::to_string(s.contact_pairs), std::to_string(s.contact_impulses),
                                        std::to_string(s.impact_zones), std::to_string(s.contact_unresolved),
-                                       format_double(s.contact_ms)})
+                                       format_double(s.contact_ms), std::to_string(s.contact_response_iterations),
+                                       std::to_string(s.contact_cg_iterations)})
         row.append(1, ',').append(field);
     stats_.line(row);
     stats_.flush();
@@ -413,6 +417,8 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
         totals.contact_broad_ms += s.contact_broad_ms;
         totals.contact_narrow_ms += s.contact_narrow_ms;
         totals.contact_response_ms += s.contact_response_ms;
+        totals.contact_response_iterations += s.contact_response_iterations;
+        totals.contact_cg_iterations += s.contact_cg_iterations;
         outputs->record_stats(s);
         outputs->record_state(*sim, s.step, s.t, totals);
       } catch (const SimulationError&) {

@@ -1,6 +1,7 @@
 #include "sim/contact/contact_stage.hpp"
 
 #include "sim/contact/narrow_phase.hpp"
+#include "sim/solver/cholesky_preconditioner.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -181,6 +182,8 @@ struct ContactStage::Impl {
       : d(disc), settings(s), params(p), obstacles(std::move(obs)), free(free_dofs), node_mass(mass) {
     if (!(settings.thickness > 0)) throw std::invalid_argument("collision: the thickness must be > 0 [m]");
     if (!(settings.friction >= 0)) throw std::invalid_argument("collision: the friction coefficient must be >= 0");
+    if (!(settings.tolerance > 0 && settings.tolerance <= 0.1))
+      throw std::invalid_argument("collision: the tolerance must be > 0 and at most 0.1");
     if (params.surface_level < 0) throw std::invalid_argument("collision: the surface level must be >= 0");
     surface = d.display(params.surface_level);
     jacobian = d.point_jacobian(surface);
@@ -817,22 +820,25 @@ struct ContactStage::Impl {
   //     ½ |v − v*|²_A + Σ (1 / 2κᵢ) max(0, λᵢ + κᵢ gᵢ)² + Σ Ψᵢ(wᵢ),   ∇Ψᵢ = Π(fᵢ + κᵢ wᵢ),
   // Π the projection on the disc of radius μᵢ λᵢ (the Moreau envelope of μ λ |w|); the function is
   // piecewise quadratic but for sliding pairs, and each Newton step solves
-  // (A + Σ κᵢ (normal and tangential blocks)) δ = −∇ by conjugate gradients preconditioned with the
-  // step's factorisation or preconditioner. Then λᵢ ← max(0, λᵢ + κᵢ gᵢ), fᵢ ← Π(fᵢ + κᵢ wᵢ),
-  // until every constraint and every sticking pair is met to `tolerance`, in velocity. κᵢ =
+  // (A + Σ κᵢ (normal and tangential blocks)) δ = −∇ by conjugate gradients preconditioned with a
+  // Cholesky factor of that matrix (on A's pattern; refreshed when the solves slow down). Then
+  // λᵢ ← max(0, λᵢ + κᵢ gᵢ), fᵢ ← Π(fᵢ + κᵢ wᵢ), the disc's radius μᵢ λᵢ following λᵢ for the
+  // first `friction_updates` updates only (lagged friction: then the problem is convex), until
+  // every constraint and every sticking pair is met to `tolerance`, in velocity. κᵢ =
   // penalty_ratio / (Σ (B·n)² / D), D the diagonal of A. The multipliers stay in the constraints:
   // the next pass starts from them.
   void implicit_response(std::vector<Found>& found, const Eigen::VectorXd& base, Eigen::VectorXd& v, ContactReport& report) {
     const auto t0 = Clock::now();
     end_points_current = false;
     const Eigen::Index n3 = v.size();
-    const double tolerance = params.response_tolerance * settings.thickness / h;
+    const double tolerance = settings.tolerance * settings.thickness / h;
     struct Row {
       std::vector<std::pair<int, Eigen::Vector3d>> b;  // free DOFs
       Eigen::Vector3d constant = Eigen::Vector3d::Zero();  // eᵢ
       Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
       Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity();  // I − n nᵀ
       double kappa = 0.0, target = 0.0, mu = 0.0;
+      double radius = 0.0;  // of the friction disc, μ times a normal impulse
       Constraint* c = nullptr;
       // Newton's linearisation at the current v:
       bool normal_active = false;
@@ -863,6 +869,7 @@ struct ContactStage::Impl {
       r.kappa = params.penalty_ratio / w;
       r.target = con.target;
       r.mu = con.mu;
+      r.radius = con.mu * con.lambda;
       r.c = &con;
       con.friction = r.tangent * con.friction;
       rows.push_back(std::move(r));
@@ -885,7 +892,7 @@ struct ContactStage::Impl {
     Eigen::VectorXd gradient(n3), step(n3), change(n3), moved_by(n3);
     const Eigen::SparseMatrix<double>& a = system->matrix;
     auto penalised_product = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
-      y.noalias() = a * x;
+      symmetric_product(a, x, mask, y);
       for (const Row& r : rows) {
         const Eigen::Vector3d u = relative(r, x);
         Eigen::Vector3d force = r.friction_hessian * u;
@@ -904,7 +911,7 @@ struct ContactStage::Impl {
         Row& r = rows[i];
         const Eigen::Vector3d u = relative(r, x) + r.constant;
         const double s = r.c->lambda + r.kappa * (r.target - r.normal.dot(u));
-        const double radius = r.mu * r.c->lambda;
+        const double radius = r.radius;
         const Eigen::Vector3d y = r.c->friction + r.kappa * (r.tangent * u);
         const double excess = std::max(0.0, y.norm() - radius);
         value += (s > 0 ? s * s : 0.0) / (2.0 * r.kappa) + (y.squaredNorm() - excess * excess) / (2.0 * r.kappa);
@@ -925,6 +932,40 @@ struct ContactStage::Impl {
       if (linearise) gradient = gradient.cwiseProduct(mask);
       return value;
     };
+    // The conjugate gradients' preconditioner: a Cholesky factor of the Newton matrix
+    // A + Σ κᵢ Bᵢᵀ Hᵢ Bᵢ (Hᵢ the row's normal and friction blocks as last linearised) restricted
+    // to A's pattern, made when a solve needs more than `refactor_iterations` and kept across
+    // calls and steps while it serves (before the first one: the step's own preconditioner).
+    auto precondition = [this](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+      if (newton_factor && newton_factor->ready())
+        newton_factor->apply(r, z);
+      else
+        system->inverse(r, z);
+    };
+    auto factor_newton_matrix = [&]() {
+      newton_matrix = a;  // the step's pattern, the same every step
+      newton_matrix.makeCompressed();
+      double* values = newton_matrix.valuePtr();
+      const int* outer_index = newton_matrix.outerIndexPtr();
+      const int* inner_index = newton_matrix.innerIndexPtr();
+      auto entry = [&](int row, int col) -> double* {  // null when (row, col) is not in the pattern
+        const int* first = inner_index + outer_index[col];
+        const int* last = inner_index + outer_index[col + 1];
+        const int* it = std::lower_bound(first, last, row);
+        return it != last && *it == row ? values + (it - inner_index) : nullptr;
+      };
+      for (const Row& r : rows) {
+        Eigen::Matrix3d hessian = r.friction_hessian;
+        if (r.normal_active) hessian += r.kappa * r.normal * r.normal.transpose();
+        for (const auto& [i, bi] : r.b) {
+          const Eigen::Vector3d hb = hessian * bi;
+          for (const auto& [j, bj] : r.b)
+            if (double* e = entry(j, i)) *e += bj.dot(hb);
+        }
+      }
+      if (!newton_factor) newton_factor = std::make_unique<CholeskyPreconditioner>();
+      if (!newton_factor->factorize(newton_matrix, &free)) newton_factor.reset();  // then the step's own
+    };
     Eigen::VectorXd v_outer = v;
     for (int outer = 0; outer < params.response_iterations; ++outer) {
       // Damped Newton on the (convex, once differentiable) function: the friction term is linear
@@ -932,10 +973,15 @@ struct ContactStage::Impl {
       int newton = 0;
       for (; newton < 30; ++newton) {
         const double value = merit(v, true);
+        if (newton > 0) {  // after a step: done when the preconditioner's estimate of the next is tiny
+          precondition(-gradient, step);
+          if (step.cwiseProduct(mask).cwiseAbs().maxCoeff() <= 0.01 * tolerance) break;
+        }
         step.setZero();
-        const PcgResult result = solve_pcg(LinearOperator(penalised_product), -gradient, free, step,
-                                           params.response_cg_tolerance, 10 * static_cast<int>(n3) + 100, system->inverse);
+        const PcgResult result = solve_pcg(LinearOperator(penalised_product), -gradient, free, step, params.response_cg_tolerance,
+                                     10 * static_cast<int>(n3) + 100, precondition);
         report.response_cg_iterations += result.iterations;
+        if (result.iterations > params.refactor_iterations) factor_newton_matrix();
         const double slope = gradient.dot(step);
         if (step.cwiseAbs().maxCoeff() <= 0.1 * tolerance || !(slope < 0)) {
           if (slope < 0) v += step;
@@ -954,7 +1000,10 @@ struct ContactStage::Impl {
         const Eigen::Vector3d u = relative(r, v) + r.constant;
         const double g = r.target - r.normal.dot(u);
         const double lambda = std::max(0.0, r.c->lambda + r.kappa * g);
-        const Eigen::Vector3d updated = disc(r.c->friction + r.kappa * (r.tangent * u), r.mu * lambda);
+        // The Coulomb disc follows the normal impulse for the first `friction_updates` updates,
+        // then stays: the rest is a convex problem (friction with a given bound only dissipates).
+        if (outer < params.friction_updates) r.radius = r.mu * lambda;
+        const Eigen::Vector3d updated = disc(r.c->friction + r.kappa * (r.tangent * u), r.radius);
         worst = std::max(worst, g);
         const Eigen::Vector3d impulse = (lambda - r.c->lambda) * r.normal - (updated - r.c->friction);
         for (const auto& [dof, b] : r.b) change(dof) += b.dot(impulse);
@@ -1050,6 +1099,8 @@ struct ContactStage::Impl {
 
   // --- The stage ---------------------------------------------------------------------------------
   const ResponseSystem* system = nullptr;
+  std::unique_ptr<CholeskyPreconditioner> newton_factor;  // of the implicit response's Newton matrix
+  Eigen::SparseMatrix<double> newton_matrix;
   Eigen::VectorXd system_diagonal;  // of A, per DOF
 
   std::vector<Found> constraints;  // this step's, with their multipliers

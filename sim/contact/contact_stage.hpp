@@ -49,6 +49,7 @@ struct ContactReport {
   int impulses = 0;            // pairs given a normal impulse, plus friction impulses applied
   int response_iterations = 0;     // augmented-Lagrangian iterations of the implicit response
   long long response_cg_iterations = 0;  // conjugate-gradient iterations in them
+  int response_factorizations = 0;  // factorisations of the response's Newton matrix
   int ccd_collisions = 0;      // colliding pairs found by CCD, summed over the passes
   int impact_zones = 0;        // zones the fail-safe made move as one (0 when not needed)
   int unresolved = 0;          // pairs still colliding when the fail-safe gave up (should be 0)
@@ -62,8 +63,6 @@ struct ContactParameters {
   double near_separation_ratio = 0.01;  // ... and this fraction between parts near each other at rest
   double repulsion_ratio = 0.1;      // pairs that start a step closer than the minimum separation are
                                      // pushed apart by this fraction of the shortfall per step
-  int proximity_sweeps = 50;         // Gauss–Seidel friction sweeps, at most (they stop when every
-                                     // pair is settled to 1e-3 thickness per step)
   int ccd_passes = 8;                // CCD and response passes before the fail-safe
   int zone_rounds = 100;             // fail-safe rounds before giving up (reported as unresolved)
   // The implicit response (augmented Lagrangian on the step's system): penalty per constraint
@@ -71,8 +70,9 @@ struct ContactParameters {
   // and the relative tolerance of the inner conjugate-gradient solves.
   double penalty_ratio = 10.0;
   int response_iterations = 10;
-  double response_tolerance = 1e-4;  // in velocity: this fraction of the thickness per step
+  int friction_updates = 3;          // updates in which the friction bound follows the normal impulse
   double response_cg_tolerance = 1e-6;
+  int refactor_iterations = 15;      // refactorise the Newton matrix after a solve that needed more
 };
 
 // The step's linear system for the implicit response: A = M + h D + h² K (only the rows and

@@ -27,6 +27,8 @@ struct CollisionSettings {
   bool self = false;          // self-collision of the cloth
   double thickness = 1e-3;    // [m] the distance contact keeps between surfaces
   double friction = 0.3;      // [-] Coulomb coefficient cloth–cloth, and the obstacles' default
+  double tolerance = 1e-3;    // [-] of the contact response, in velocity: this fraction of the
+                              // thickness per step (docs/contact.md)
 };
 
 struct Obstacle {

@@ -34,6 +34,8 @@ class ContactFilter final : public VelocityFilter {
     stats.contact_broad_ms += r.broad_ms;
     stats.contact_narrow_ms += r.narrow_ms;
     stats.contact_response_ms += r.response_ms;
+    stats.contact_response_iterations += r.response_iterations;
+    stats.contact_cg_iterations += r.response_cg_iterations;
   }
 
  private:

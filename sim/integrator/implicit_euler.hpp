@@ -80,6 +80,8 @@ struct StepStats {
   int contact_unresolved = 0;    // pairs still colliding at the end of the step (should be 0)
   double contact_ms = 0.0;       // time of the filter [ms], of it:
   double contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;  // its phases
+  int contact_response_iterations = 0;   // augmented-Lagrangian updates of the implicit response
+  long long contact_cg_iterations = 0;   // conjugate-gradient iterations in them
 };
 
 // The step's linear system as the solve left it, for a velocity filter that responds implicitly:

@@ -673,15 +673,19 @@ void read_output(const Reader& r, const Json* j, Scene& scene) {
   }
 }
 
-// "collision": {"self": bool, "thickness": m, "friction": -, "surface_level": int}.
+// "collision": {"self": bool, "thickness": m, "friction": -, "tolerance": -, "surface_level": int}.
 void read_collision(const Reader& r, const Json* j, Problem& problem, bool& level_given) {
   level_given = false;
   if (j == nullptr) return;
-  r.check_object(*j, "collision", {"self", "thickness", "friction", "surface_level"});
+  r.check_object(*j, "collision", {"self", "thickness", "friction", "tolerance", "surface_level"});
   CollisionSettings& c = problem.collision;
   if (const Json* v = r.find(*j, "self")) c.self = r.boolean(*v, "collision.self");
   if (const Json* v = r.find(*j, "thickness")) c.thickness = r.positive(*v, "collision.thickness", "[m]");
   if (const Json* v = r.find(*j, "friction")) c.friction = r.non_negative(*v, "collision.friction", "[-]");
+  if (const Json* v = r.find(*j, "tolerance")) {
+    c.tolerance = r.positive(*v, "collision.tolerance", "[-]");
+    if (c.tolerance > 0.1) r.fail("collision.tolerance", "must be > 0 and at most 0.1 (got " + v->dump() + ")");
+  }
   if (const Json* v = r.find(*j, "surface_level")) {
     problem.collision_level = r.integer_at_least(*v, "collision.surface_level", 0);
     if (problem.collision_level > 4)

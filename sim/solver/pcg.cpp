@@ -9,12 +9,11 @@
 
 namespace clothsim {
 
-namespace {
-
 // y = A x for symmetric A in compressed-column storage: y_j = (column j) · x, so the columns can
 // be shared among threads without write conflicts. Rows of constrained entries give zero.
 void symmetric_product(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& x, const Eigen::VectorXd& mask,
                        Eigen::VectorXd& y) {
+  y.resize(a.outerSize());
   const int* outer = a.outerIndexPtr();
   const int* inner = a.innerIndexPtr();
   const double* values = a.valuePtr();
@@ -26,6 +25,8 @@ void symmetric_product(const Eigen::SparseMatrix<double>& a, const Eigen::Vector
     }
   });
 }
+
+namespace {
 
 // r = (b − A x) on the free entries, in parallel over the columns like symmetric_product (A is
 // symmetric up to round-off: row j of A x is taken as column j · x). r_j starts from b_j and

@@ -37,6 +37,11 @@ using LinearOperator = std::function<void(const Eigen::VectorXd& x, Eigen::Vecto
 PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
                     double tolerance, int max_iterations, const Preconditioner& preconditioner);
 
+// y = A x (A symmetric, compressed, full storage) times the mask entry by entry (1 for free
+// entries, 0 for the others), in parallel over the columns, in a fixed order.
+void symmetric_product(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& x, const Eigen::VectorXd& mask,
+                       Eigen::VectorXd& y);
+
 // The block-Jacobi preconditioner of A on the free entries: the inverse of each vertex's 3 × 3
 // diagonal block (its constrained rows and columns zero).
 Preconditioner block_jacobi(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free);

@@ -197,6 +197,8 @@ TEST_F(ContactKeys, CollisionWithoutObstacles) {
   EXPECT_TRUE(s.problem.collision.self);
   EXPECT_DOUBLE_EQ(s.problem.collision.thickness, 0.001);
   EXPECT_DOUBLE_EQ(s.problem.collision.friction, 0.3);
+  EXPECT_DOUBLE_EQ(s.problem.collision.tolerance, 1e-3);
+  EXPECT_DOUBLE_EQ(load(dynamic_scene(R"(, "collision": {"self": true, "tolerance": 1e-5})")).problem.collision.tolerance, 1e-5);
   EXPECT_TRUE(s.problem.obstacles.empty());
   EXPECT_TRUE(s.problem.has_contact());
 
@@ -241,6 +243,8 @@ TEST_F(ContactKeys, CollisionErrors) {
   EXPECT_EQ(collision(R"({"thickness": 0})"), expected("collision.thickness: must be > 0 [m] (got 0)"));
   EXPECT_EQ(collision(R"({"thickness": -1})"), expected("collision.thickness: must be > 0 [m] (got -1)"));
   EXPECT_EQ(collision(R"({"friction": -0.1})"), expected("collision.friction: must be >= 0 [-] (got -0.1)"));
+  EXPECT_EQ(collision(R"({"tolerance": 0})"), expected("collision.tolerance: must be > 0 [-] (got 0)"));
+  EXPECT_EQ(collision(R"({"tolerance": 0.5})"), expected("collision.tolerance: must be > 0 and at most 0.1 (got 0.5)"));
   EXPECT_EQ(collision(R"({"surface_level": 7})"),
             expected("collision.surface_level: must be an integer from 0 to 4 (got 7)"));
   EXPECT_EQ(collision(R"({"surface_level": -1})"),
@@ -249,7 +253,7 @@ TEST_F(ContactKeys, CollisionErrors) {
   EXPECT_EQ(collision(R"({"self": "yes"})"), expected("collision.self: expected true or false (got \"yes\")"));
   EXPECT_TRUE(contains(collision(R"({"thickness": "1mm"})"), expected("collision.thickness: expected a number")));
   EXPECT_EQ(collision(R"({"margin": 0.01})"),
-            expected("collision.margin: unknown key (allowed: self, thickness, friction, surface_level)"));
+            expected("collision.margin: unknown key (allowed: self, thickness, friction, tolerance, surface_level)"));
   EXPECT_TRUE(contains(collision("true"), expected("collision: expected an object")));
 }
 
@@ -533,7 +537,8 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
     std::getline(in, line);
     return line;
   };
-  const std::string contact_columns = ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms";
+  const std::string contact_columns =
+      ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations";
   const std::string header_with = first_line(out() / "touch" / "stats.csv");
   const std::string header_without = first_line(out() / "free" / "stats.csv");
   EXPECT_EQ(header_with.size() >= contact_columns.size() &&
@@ -547,7 +552,8 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
   const nlohmann::json sb = nlohmann::json::parse(clothsim::testing::read_file_bytes(out() / "free" / "summary.json"));
   ASSERT_TRUE(sa.contains("contact")) << sa.dump();
   for (const char* key : {"pairs_tested", "impulses", "impact_zones", "unresolved_pairs", "seconds",
-                          "broad_phase_seconds", "narrow_phase_seconds", "response_seconds"})
+                          "broad_phase_seconds", "narrow_phase_seconds", "response_seconds", "response_iterations",
+                          "response_cg_iterations"})
     EXPECT_TRUE(sa["contact"].contains(key)) << key << ": " << sa.dump();
   EXPECT_GT(sa["contact"]["pairs_tested"].get<long long>(), 0);  // the cloth starts within the thickness
   EXPECT_FALSE(sb.contains("contact")) << sb.dump();
