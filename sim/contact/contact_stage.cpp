@@ -943,28 +943,43 @@ struct ContactStage::Impl {
         system->inverse(r, z);
     };
     auto factor_newton_matrix = [&]() {
-      newton_matrix = a;  // the step's pattern, the same every step
-      newton_matrix.makeCompressed();
-      double* values = newton_matrix.valuePtr();
-      const int* outer_index = newton_matrix.outerIndexPtr();
-      const int* inner_index = newton_matrix.innerIndexPtr();
-      auto entry = [&](int row, int col) -> double* {  // null when (row, col) is not in the pattern
-        const int* first = inner_index + outer_index[col];
-        const int* last = inner_index + outer_index[col + 1];
-        const int* it = std::lower_bound(first, last, row);
-        return it != last && *it == row ? values + (it - inner_index) : nullptr;
-      };
+      // The pattern: A's and every coupling of the current constraints (two cloth parts in contact
+      // couple nodes far apart in the mesh). It is rebuilt, with a new symbolic analysis, only when
+      // a constraint needs a coupling it lacks.
+      std::vector<std::vector<int>> row_nodes(rows.size());
+      bool covered = newton_pattern.matrix.rows() == n3 && newton_pattern.a_entries == a.nonZeros();
+      for (size_t k = 0; k < rows.size(); ++k) {
+        std::vector<int>& nodes = row_nodes[k];
+        for (const auto& entry : rows[k].b) nodes.push_back(entry.first / 3);
+        std::sort(nodes.begin(), nodes.end());
+        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+        for (size_t x = 0; covered && x < nodes.size(); ++x)
+          for (size_t y = 0; covered && y < nodes.size(); ++y)
+            covered = newton_pattern.has(nodes[x], nodes[y]);
+      }
+      if (!covered) {
+        newton_pattern.rebuild(a, row_nodes, d.num_nodes());
+        newton_factor = std::make_unique<CholeskyPreconditioner>();
+      }
+      Eigen::SparseMatrix<double>& m = newton_pattern.matrix;
+      double* values = m.valuePtr();
+      std::fill(values, values + m.nonZeros(), 0.0);
+      for (Eigen::Index k = 0; k < a.nonZeros(); ++k) values[newton_pattern.from_a[static_cast<size_t>(k)]] += a.valuePtr()[k];
+      const int* outer_index = m.outerIndexPtr();
+      const int* inner_index = m.innerIndexPtr();
       for (const Row& r : rows) {
         Eigen::Matrix3d hessian = r.friction_hessian;
         if (r.normal_active) hessian += r.kappa * r.normal * r.normal.transpose();
         for (const auto& [i, bi] : r.b) {
           const Eigen::Vector3d hb = hessian * bi;
-          for (const auto& [j, bj] : r.b)
-            if (double* e = entry(j, i)) *e += bj.dot(hb);
+          const int* first = inner_index + outer_index[i];
+          const int* last = inner_index + outer_index[i + 1];
+          for (const auto& [j, bj] : r.b) values[std::lower_bound(first, last, j) - inner_index] += bj.dot(hb);
         }
       }
+      ++report.response_factorizations;
       if (!newton_factor) newton_factor = std::make_unique<CholeskyPreconditioner>();
-      if (!newton_factor->factorize(newton_matrix, &free)) newton_factor.reset();  // then the step's own
+      if (!newton_factor->factorize(m, &free)) newton_factor.reset();  // then the step's own preconditioner
     };
     Eigen::VectorXd v_outer = v;
     for (int outer = 0; outer < params.response_iterations; ++outer) {
@@ -978,10 +993,20 @@ struct ContactStage::Impl {
           if (step.cwiseProduct(mask).cwiseAbs().maxCoeff() <= 0.01 * tolerance) break;
         }
         step.setZero();
-        const PcgResult result = solve_pcg(LinearOperator(penalised_product), -gradient, free, step, params.response_cg_tolerance,
-                                     10 * static_cast<int>(n3) + 100, precondition);
+        // A solve that needs many iterations has an out-of-date preconditioner: it is stopped,
+        // the Newton matrix refactorised, and the solve goes on from where it stopped.
+        const LinearOperator newton_operator(penalised_product);
+        PcgResult result = solve_pcg(newton_operator, -gradient, free, step, params.response_cg_tolerance,
+                                     3 * params.refactor_iterations, precondition);
         report.response_cg_iterations += result.iterations;
-        if (result.iterations > params.refactor_iterations) factor_newton_matrix();
+        if (!result.converged) {
+          factor_newton_matrix();
+          result = solve_pcg(newton_operator, -gradient, free, step, params.response_cg_tolerance, 10 * static_cast<int>(n3) + 100,
+                             precondition);
+          report.response_cg_iterations += result.iterations;
+        } else if (result.iterations > params.refactor_iterations) {
+          factor_newton_matrix();
+        }
         const double slope = gradient.dot(step);
         if (step.cwiseAbs().maxCoeff() <= 0.1 * tolerance || !(slope < 0)) {
           if (slope < 0) v += step;
@@ -1100,7 +1125,49 @@ struct ContactStage::Impl {
   // --- The stage ---------------------------------------------------------------------------------
   const ResponseSystem* system = nullptr;
   std::unique_ptr<CholeskyPreconditioner> newton_factor;  // of the implicit response's Newton matrix
-  Eigen::SparseMatrix<double> newton_matrix;
+  // The pattern of that matrix: A's and the node couplings of the constraints it was made for.
+  struct NewtonPattern {
+    Eigen::SparseMatrix<double> matrix;                // the pattern, with the last values
+    Eigen::Index a_entries = -1;                       // A's entries when it was built
+    std::vector<int> from_a;                           // A's k-th stored entry is matrix's from_a[k]-th
+    std::vector<std::vector<int>> adjacency;           // per node, the coupled nodes (sorted)
+    bool has(int p, int q) const {
+      const std::vector<int>& row = adjacency[static_cast<size_t>(p)];
+      return std::binary_search(row.begin(), row.end(), q);
+    }
+    void rebuild(const Eigen::SparseMatrix<double>& a, const std::vector<std::vector<int>>& row_nodes, int num_nodes) {
+      adjacency.assign(static_cast<size_t>(num_nodes), {});
+      for (Eigen::Index col = 0; col < a.outerSize(); ++col)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it)
+          adjacency[static_cast<size_t>(col / 3)].push_back(static_cast<int>(it.row() / 3));
+      for (const std::vector<int>& nodes : row_nodes)
+        for (int p : nodes) adjacency[static_cast<size_t>(p)].insert(adjacency[static_cast<size_t>(p)].end(), nodes.begin(), nodes.end());
+      std::vector<Eigen::Triplet<double>> entries;
+      for (size_t p = 0; p < adjacency.size(); ++p) {
+        std::vector<int>& row = adjacency[p];
+        std::sort(row.begin(), row.end());
+        row.erase(std::unique(row.begin(), row.end()), row.end());
+        for (int q : row)
+          for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) entries.emplace_back(3 * q + i, 3 * static_cast<int>(p) + j, 0.0);
+      }
+      matrix.resize(a.rows(), a.cols());
+      matrix.setFromTriplets(entries.begin(), entries.end());
+      matrix.makeCompressed();
+      a_entries = a.nonZeros();
+      from_a.assign(static_cast<size_t>(a.nonZeros()), 0);
+      const int* outer_index = matrix.outerIndexPtr();
+      const int* inner_index = matrix.innerIndexPtr();
+      for (Eigen::Index col = 0; col < a.outerSize(); ++col)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
+          const int* first = inner_index + outer_index[col];
+          const int* last = inner_index + outer_index[col + 1];
+          from_a[static_cast<size_t>(&it.valueRef() - a.valuePtr())] =
+              static_cast<int>(std::lower_bound(first, last, static_cast<int>(it.row())) - inner_index);
+        }
+    }
+  };
+  NewtonPattern newton_pattern;
   Eigen::VectorXd system_diagonal;  // of A, per DOF
 
   std::vector<Found> constraints;  // this step's, with their multipliers
