@@ -965,16 +965,36 @@ struct ContactStage::Impl {
       double* values = m.valuePtr();
       std::fill(values, values + m.nonZeros(), 0.0);
       for (Eigen::Index k = 0; k < a.nonZeros(); ++k) values[newton_pattern.from_a[static_cast<size_t>(k)]] += a.valuePtr()[k];
+      // Each constraint adds Bₚᵀ H B_q for every pair of its nodes (B_k: the 3 × 3 block of node k):
+      // the pattern holds full node blocks, so node p's rows in column 3q + c start at
+      // outer[3q + c] + 3 · (p's rank among q's coupled nodes).
       const int* outer_index = m.outerIndexPtr();
-      const int* inner_index = m.innerIndexPtr();
+      std::vector<std::pair<int, Eigen::Matrix3d>> blocks;  // (node, B_k)
       for (const Row& r : rows) {
         Eigen::Matrix3d hessian = r.friction_hessian;
         if (r.normal_active) hessian += r.kappa * r.normal * r.normal.transpose();
-        for (const auto& [i, bi] : r.b) {
-          const Eigen::Vector3d hb = hessian * bi;
-          const int* first = inner_index + outer_index[i];
-          const int* last = inner_index + outer_index[i + 1];
-          for (const auto& [j, bj] : r.b) values[std::lower_bound(first, last, j) - inner_index] += bj.dot(hb);
+        if (hessian.isZero(0.0)) continue;
+        blocks.clear();
+        for (const auto& [dof, b] : r.b) {
+          const int node = dof / 3;
+          auto it = std::find_if(blocks.begin(), blocks.end(), [node](const auto& e) { return e.first == node; });
+          if (it == blocks.end()) {
+            blocks.emplace_back(node, Eigen::Matrix3d::Zero());
+            it = blocks.end() - 1;
+          }
+          it->second.col(dof % 3) = b;
+        }
+        for (const auto& [q, bq] : blocks) {
+          const Eigen::Matrix3d hbq = hessian * bq;
+          const std::vector<int>& coupled = newton_pattern.adjacency[static_cast<size_t>(q)];
+          for (const auto& [p, bp] : blocks) {
+            const int rank = static_cast<int>(std::lower_bound(coupled.begin(), coupled.end(), p) - coupled.begin());
+            const Eigen::Matrix3d block = bp.transpose() * hbq;
+            for (int c = 0; c < 3; ++c) {
+              double* column = values + outer_index[3 * q + c] + 3 * rank;
+              for (int k = 0; k < 3; ++k) column[k] += block(k, c);
+            }
+          }
         }
       }
       ++report.response_factorizations;
