@@ -228,6 +228,36 @@ struct ContactStage::Impl {
     build_edges(obstacle_triangles, obstacle_edges, obstacle_triangle_edges);
     build_ownership(obstacle_triangles, static_cast<int>(obstacle_of_vertex.size()), obstacle_triangle_edges,
                     static_cast<int>(obstacle_edges.size()), obstacle_owned_points, obstacle_owned_edges);
+    drop_flat_obstacle_edges();
+  }
+
+  // An obstacle edge between two coplanar triangles (inside a flat face: a box side, a cylinder's
+  // cap) makes no pair of its own. The obstacle is rigid, so the face stays flat; a segment's
+  // distance to a flat region is attained at one of its end points (point–triangle pairs) or on
+  // the region's boundary (its other edges), and so is its first contact when it moves (where it
+  // touches the region's inside at an inner point, it lies in the plane and crosses the boundary
+  // too). On the Cusick support's cap these edges made two thirds of the constraints.
+  void drop_flat_obstacle_edges() {
+    std::vector<std::vector<int>> edge_triangles(obstacle_edges.size());
+    for (size_t t = 0; t < obstacle_triangle_edges.size(); ++t)
+      for (int e : obstacle_triangle_edges[t]) edge_triangles[static_cast<size_t>(e)].push_back(static_cast<int>(t));
+    Eigen::MatrixX3d rest(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
+    for (size_t k = 0; k < obstacles.size(); ++k)
+      if (obstacles[k].shape != Obstacle::Shape::plane)
+        rest.middleRows(vertex_offset[k], obstacles[k].mesh.num_vertices()) = obstacles[k].mesh.vertices;
+    auto normal = [&](int t) {
+      const Triangle& tri = obstacle_triangles[static_cast<size_t>(t)];
+      const Eigen::Vector3d a = rest.row(tri[0]), b = rest.row(tri[1]), c = rest.row(tri[2]);
+      return Eigen::Vector3d((b - a).cross(c - a));
+    };
+    std::vector<char> flat(obstacle_edges.size(), 0);
+    for (size_t e = 0; e < obstacle_edges.size(); ++e) {
+      if (edge_triangles[e].size() != 2) continue;
+      const Eigen::Vector3d n1 = normal(edge_triangles[e][0]), n2 = normal(edge_triangles[e][1]);
+      flat[e] = n1.dot(n2) > 0 && n1.cross(n2).norm() <= 1e-12 * n1.norm() * n2.norm();
+    }
+    for (std::vector<int>& owned : obstacle_owned_edges)
+      owned.erase(std::remove_if(owned.begin(), owned.end(), [&](int e) { return flat[static_cast<size_t>(e)] != 0; }), owned.end());
   }
 
   // Each point and each edge is owned by the first triangle that has it, so that expanding

@@ -797,6 +797,39 @@ TEST(ContactIntersections, SheetFallingOnASphereStaysIntersectionFree) {
   EXPECT_NEAR(nodes(6 * 13 + 6, 2), 0.16 + p.collision.thickness, 2.0 * p.collision.thickness);
 }
 
+TEST(ContactIntersections, SheetDrapedOverABoxStaysIntersectionFree) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // A 0.2 m square (10 × 10 cells) dropped from 3 cm over a 0.1 m cube on the ground: it lies on
+  // the top face (two coplanar triangles: their shared diagonal makes no edge pairs) and folds
+  // over the four sharp edges and corners.
+  Problem p = cloth_problem(transformed(make_grid(0.2, 0.2, 10, 10), Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.01, 0.02, 0.13)),
+                            2e-3, 0.3);
+  p.gravity = Eigen::Vector3d(0, 0, -kG);
+  p.damping.stiffness = 0.001;
+  p.damping.mass = 0.1;
+  p.collision.self = true;
+  p.collision.thickness = 2e-3;
+  Obstacle box;
+  box.name = "box";
+  box.shape = Obstacle::Shape::box;
+  box.center = Eigen::Vector3d(0, 0, 0.05);
+  box.size = Eigen::Vector3d(0.1, 0.1, 0.1);
+  box.friction = 0.3;
+  box.mesh = tessellate(box);
+  p.obstacles = {ground(0.5), box};
+  Simulator sim(p);
+  const IntersectionTally t = run_and_check(sim, p, p.collision_level);
+  report("sheet over a box (10 × 10, 0.3 s)", t, seconds_since(t0));
+  EXPECT_GT(t.impulses, 0);
+  EXPECT_EQ(t.self_pairs, 0) << t.first_bad;
+  EXPECT_EQ(t.obstacle_pairs, 0) << t.first_bad;
+  EXPECT_EQ(t.unresolved, 0);
+  // It hangs over the edges: drawn points below the top face, the middle resting on it.
+  const Eigen::MatrixX3d nodes = sim.node_points();
+  EXPECT_LT(nodes.col(2).minCoeff(), 0.08);
+  EXPECT_NEAR(nodes(5 * 11 + 5, 2), 0.1 + p.collision.thickness, 2.0 * p.collision.thickness);
+}
+
 // Smallest distance between drawn points whose rest positions are more than `apart` apart [m]:
 // how close two layers of a fold come (a point pair is never closer than the surfaces).
 double closest_layers(const Simulator& sim, const SurfaceOperator& op, double apart) {
