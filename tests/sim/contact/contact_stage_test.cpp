@@ -771,27 +771,39 @@ void report(const char* name, const IntersectionTally& t, double seconds) {
               t.check_seconds, seconds, t.first_bad.empty() ? "" : "; first: ", t.first_bad.c_str());
 }
 
-TEST(ContactIntersections, SheetFallingOnASphereStaysIntersectionFree) {
-  const auto t0 = std::chrono::steady_clock::now();
-  // sheet_on_sphere, smaller: 0.3 m square of 12 × 12 cells held flat 0.2 m up, dropped over a
-  // ball of radius 0.08 m resting on the ground.
-  Problem p = cloth_problem(transformed(make_grid(0.3, 0.3, 12, 12), Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 0.2)),
-                            2e-3, 0.4);
+// A square sheet (side `size`, n × n cells) held flat at (x, y, z) and dropped under gravity onto
+// `obstacles`, with light damping, self-collision, 2 mm thickness and cloth friction 0.3.
+Problem dropped_sheet(double size, int n, const Eigen::Vector3d& at, double end, std::vector<Obstacle> obstacles) {
+  Problem p = cloth_problem(transformed(make_grid(size, size, n, n), Eigen::Matrix3d::Identity(), at), 2e-3, end);
   p.gravity = Eigen::Vector3d(0, 0, -kG);
   p.damping.stiffness = 0.001;
   p.damping.mass = 0.1;
   p.collision.self = true;
   p.collision.thickness = 2e-3;
   p.collision.friction = 0.3;
-  p.obstacles = {ground(0.5), sphere(Eigen::Vector3d(0, 0, 0.08), 0.08, 0.3)};
-  Simulator sim(p);
-  const IntersectionTally t = run_and_check(sim, p, p.collision_level);
-  report("sheet on sphere (12 × 12, level 1, 0.4 s)", t, seconds_since(t0));
+  p.obstacles = std::move(obstacles);
+  return p;
+}
+
+// The run made contact and every step's drawn surface was free of intersections.
+void expect_clean(const IntersectionTally& t) {
   EXPECT_GT(t.impulses, 0);
   EXPECT_EQ(t.self_pairs, 0) << t.first_bad;
   EXPECT_EQ(t.obstacle_pairs, 0) << t.first_bad;
-  EXPECT_GT(t.lowest, 0.0) << t.first_bad;
   EXPECT_EQ(t.unresolved, 0);
+}
+
+TEST(ContactIntersections, SheetFallingOnASphereStaysIntersectionFree) {
+  const auto t0 = std::chrono::steady_clock::now();
+  // sheet_on_sphere, smaller: 0.3 m square of 12 × 12 cells held flat 0.2 m up, dropped over a
+  // ball of radius 0.08 m resting on the ground.
+  const Problem p =
+      dropped_sheet(0.3, 12, Eigen::Vector3d(0, 0, 0.2), 0.4, {ground(0.5), sphere(Eigen::Vector3d(0, 0, 0.08), 0.08, 0.3)});
+  Simulator sim(p);
+  const IntersectionTally t = run_and_check(sim, p, p.collision_level);
+  report("sheet on sphere (12 × 12, level 1, 0.4 s)", t, seconds_since(t0));
+  expect_clean(t);
+  EXPECT_GT(t.lowest, 0.0) << t.first_bad;
   // It draped: the sheet's centre rests on the ball's top (0.16 m + the thickness).
   const Eigen::MatrixX3d nodes = sim.node_points();
   EXPECT_NEAR(nodes(6 * 13 + 6, 2), 0.16 + p.collision.thickness, 2.0 * p.collision.thickness);
@@ -802,13 +814,6 @@ TEST(ContactIntersections, SheetDrapedOverABoxStaysIntersectionFree) {
   // A 0.2 m square (10 × 10 cells) dropped from 3 cm over a 0.1 m cube on the ground: it lies on
   // the top face (two coplanar triangles: their shared diagonal makes no edge pairs) and folds
   // over the four sharp edges and corners.
-  Problem p = cloth_problem(transformed(make_grid(0.2, 0.2, 10, 10), Eigen::Matrix3d::Identity(), Eigen::Vector3d(0.01, 0.02, 0.13)),
-                            2e-3, 0.3);
-  p.gravity = Eigen::Vector3d(0, 0, -kG);
-  p.damping.stiffness = 0.001;
-  p.damping.mass = 0.1;
-  p.collision.self = true;
-  p.collision.thickness = 2e-3;
   Obstacle box;
   box.name = "box";
   box.shape = Obstacle::Shape::box;
@@ -816,14 +821,11 @@ TEST(ContactIntersections, SheetDrapedOverABoxStaysIntersectionFree) {
   box.size = Eigen::Vector3d(0.1, 0.1, 0.1);
   box.friction = 0.3;
   box.mesh = tessellate(box);
-  p.obstacles = {ground(0.5), box};
+  const Problem p = dropped_sheet(0.2, 10, Eigen::Vector3d(0.01, 0.02, 0.13), 0.3, {ground(0.5), box});
   Simulator sim(p);
   const IntersectionTally t = run_and_check(sim, p, p.collision_level);
   report("sheet over a box (10 × 10, 0.3 s)", t, seconds_since(t0));
-  EXPECT_GT(t.impulses, 0);
-  EXPECT_EQ(t.self_pairs, 0) << t.first_bad;
-  EXPECT_EQ(t.obstacle_pairs, 0) << t.first_bad;
-  EXPECT_EQ(t.unresolved, 0);
+  expect_clean(t);
   // It hangs over the edges: drawn points below the top face, the middle resting on it.
   const Eigen::MatrixX3d nodes = sim.node_points();
   EXPECT_LT(nodes.col(2).minCoeff(), 0.08);
