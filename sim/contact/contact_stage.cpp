@@ -147,6 +147,7 @@ struct ContactStage::Impl {
   // The obstacles' meshes, combined (planes are apart).
   std::vector<Triangle> obstacle_triangles;
   std::vector<std::array<int, 2>> obstacle_edges;
+  std::vector<char> obstacle_edge_flat, obstacle_vertex_flat;  // between coplanar triangles; all edges flat
   std::vector<std::array<int, 3>> obstacle_triangle_edges;
   std::vector<std::vector<int>> obstacle_owned_points, obstacle_owned_edges;
   std::vector<int> obstacle_of_vertex;  // obstacle index per combined vertex
@@ -258,6 +259,36 @@ struct ContactStage::Impl {
     }
     for (std::vector<int>& owned : obstacle_owned_edges)
       owned.erase(std::remove_if(owned.begin(), owned.end(), [&](int e) { return flat[static_cast<size_t>(e)] != 0; }), owned.end());
+    obstacle_edge_flat = flat;
+    obstacle_vertex_flat.assign(obstacle_of_vertex.size(), 1);
+    for (size_t e = 0; e < obstacle_edges.size(); ++e)
+      if (!flat[e])
+        for (int v : obstacle_edges[e]) obstacle_vertex_flat[static_cast<size_t>(v)] = 0;
+  }
+
+  // A point–obstacle-triangle pair adds nothing when the point's closest point on the triangle
+  // lies on a flat edge, or on a vertex inside a flat face, while the point is not over the
+  // triangle: then it is over a coplanar neighbour (or beyond it), which is at least as close and
+  // makes its own pair; at a first contact, that neighbour is touched first or at the same time.
+  // (A point right over the shared edge or vertex keeps every pair: all give the same constraint.)
+  bool redundant_on_flat_face(const Candidate& c, const PairGeometry& g, const std::array<Eigen::Vector3d, 4>& x) const {
+    if (c.kind != Kind::cloth_point_obstacle_triangle) return false;
+    const Eigen::Vector3d n = (x[2] - x[1]).cross(x[3] - x[1]);
+    if (g.normal.cross(n).norm() <= 1e-9 * n.norm()) return false;
+    const auto& tri = obstacle_triangles[static_cast<size_t>(c.b)];
+    const auto& tri_edges = obstacle_triangle_edges[static_cast<size_t>(c.b)];
+    int zeros = 0, zero = -1, nonzero = -1;
+    for (int k = 0; k < 3; ++k) {
+      if (-g.coef[static_cast<size_t>(k + 1)] <= 0.0) {
+        ++zeros;
+        zero = k;
+      } else {
+        nonzero = k;
+      }
+    }
+    if (zeros == 1) return obstacle_edge_flat[static_cast<size_t>(tri_edges[static_cast<size_t>((zero + 1) % 3)])] != 0;
+    if (zeros == 2) return obstacle_vertex_flat[static_cast<size_t>(tri[static_cast<size_t>(nonzero)])] != 0;
+    return false;
   }
 
   // Each point and each edge is owned by the first triangle that has it, so that expanding
@@ -743,8 +774,11 @@ struct ContactStage::Impl {
     std::vector<char> close(cands.size(), 0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t i = range.begin(); i != range.end(); ++i)
-        if (!cands[i].near)  // neighbours in the material: only kept from crossing (collisions)
-          close[i] = geometry(cands[i], corners(cands[i], false)).distance < settings.thickness;
+        if (!cands[i].near) {  // neighbours in the material: only kept from crossing (collisions)
+          const std::array<Eigen::Vector3d, 4> x = corners(cands[i], false);
+          const PairGeometry g = geometry(cands[i], x);
+          close[i] = g.distance < settings.thickness && !redundant_on_flat_face(cands[i], g, x);
+        }
     });
     for (size_t i = 0; i < cands.size(); ++i) {
       if (!cands[i].near) ++report.pairs_tested;
@@ -825,6 +859,7 @@ struct ContactStage::Impl {
       std::array<Eigen::Vector3d, 4> x;
       for (size_t k = 0; k < 4; ++k) x[k] = a[k] + toi[i] * (b[k] - a[k]);
       const PairGeometry g = geometry(c, x);
+      if (redundant_on_flat_face(c, g, x)) continue;
       out.push_back({constraint(g), g.distance, separation, key_of(c, 1)});
       if (hit_pairs) hit_pairs->push_back(c);
     }
