@@ -908,6 +908,7 @@ struct ContactStage::Impl {
       // Newton's linearisation at the current v:
       bool normal_active = false;
       Eigen::Matrix3d friction_hessian = Eigen::Matrix3d::Zero();
+      bool passive() const { return !normal_active && friction_hessian.isZero(0.0); }  // adds nothing to the matrix
     };
     std::vector<Row> rows;
     rows.reserve(found.size());
@@ -959,6 +960,7 @@ struct ContactStage::Impl {
     auto penalised_product = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
       symmetric_product(a, x, mask, y);
       for (const Row& r : rows) {
+        if (r.passive()) continue;
         const Eigen::Vector3d u = relative(r, x);
         Eigen::Vector3d force = r.friction_hessian * u;
         if (r.normal_active) force += r.kappa * r.normal.dot(u) * r.normal;
@@ -985,7 +987,9 @@ struct ContactStage::Impl {
         r.normal_active = s > 0;
         Eigen::Vector3d force = r.normal_active ? Eigen::Vector3d(-s * r.normal) : Eigen::Vector3d::Zero();
         const bool stick = excess == 0.0;
-        if (stick) {
+        if (!(radius > 0)) {  // no friction: the envelope of 0 is 0
+          r.friction_hessian.setZero();
+        } else if (stick) {
           r.friction_hessian = r.kappa * r.tangent;
         } else {
           const Eigen::Vector3d e = y.normalized();
@@ -1037,8 +1041,8 @@ struct ContactStage::Impl {
       std::vector<std::pair<int, Eigen::Matrix3d>> blocks;  // (node, B_k)
       for (const Row& r : rows) {
         Eigen::Matrix3d hessian = r.friction_hessian;
+        if (r.passive()) continue;
         if (r.normal_active) hessian += r.kappa * r.normal * r.normal.transpose();
-        if (hessian.isZero(0.0)) continue;
         blocks.clear();
         for (const auto& [dof, b] : r.b) {
           const int node = dof / 3;
