@@ -954,7 +954,7 @@ struct ContactStage::Impl {
       if (norm <= radius) return y;
       return norm > 0 ? Eigen::Vector3d((radius / norm) * y) : Eigen::Vector3d::Zero();
     };
-    const Eigen::VectorXd mask = free_mask();
+    const Eigen::VectorXd mask = clothsim::free_mask(free);
     Eigen::VectorXd gradient(n3), step(n3), change(n3), moved_by(n3);
     const Eigen::SparseMatrix<double>& a = system->matrix;
     auto penalised_product = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
@@ -1040,8 +1040,8 @@ struct ContactStage::Impl {
       const int* outer_index = m.outerIndexPtr();
       std::vector<std::pair<int, Eigen::Matrix3d>> blocks;  // (node, B_k)
       for (const Row& r : rows) {
-        Eigen::Matrix3d hessian = r.friction_hessian;
         if (r.passive()) continue;
+        Eigen::Matrix3d hessian = r.friction_hessian;
         if (r.normal_active) hessian += r.kappa * r.normal * r.normal.transpose();
         blocks.clear();
         for (const auto& [dof, b] : r.b) {
@@ -1140,11 +1140,6 @@ struct ContactStage::Impl {
   }
 
   double diagonal(int dof) const { return system_diagonal(dof); }
-  Eigen::VectorXd free_mask() const {
-    Eigen::VectorXd m(static_cast<Eigen::Index>(free.size()));
-    for (size_t i = 0; i < free.size(); ++i) m(static_cast<Eigen::Index>(i)) = free[i] ? 1.0 : 0.0;
-    return m;
-  }
 
   // --- Fail-safe: impact zones -------------------------------------------------------------------
   void move_zones(Zones& zones, const std::vector<int>& zone_obstacle, const Eigen::VectorXd& x, double t,

@@ -89,13 +89,13 @@ PcgResult iterate(const LinearOperator& apply, const Preconditioner& preconditio
   return result;
 }
 
+}  // namespace
+
 Eigen::VectorXd free_mask(const std::vector<char>& free) {
   Eigen::VectorXd mask(static_cast<Eigen::Index>(free.size()));
   for (size_t i = 0; i < free.size(); ++i) mask(static_cast<Eigen::Index>(i)) = free[i] ? 1.0 : 0.0;
   return mask;
 }
-
-}  // namespace
 
 Preconditioner block_jacobi(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) {
   const Eigen::Index blocks = a.rows() / 3;

@@ -37,6 +37,9 @@ using LinearOperator = std::function<void(const Eigen::VectorXd& x, Eigen::Vecto
 PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
                     double tolerance, int max_iterations, const Preconditioner& preconditioner);
 
+// 1 for the free entries, 0 for the others.
+Eigen::VectorXd free_mask(const std::vector<char>& free);
+
 // y = A x (A symmetric, compressed, full storage) times the mask entry by entry (1 for free
 // entries, 0 for the others), in parallel over the columns, in a fixed order.
 void symmetric_product(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& x, const Eigen::VectorXd& mask,
