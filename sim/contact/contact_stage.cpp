@@ -30,6 +30,26 @@ using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 using contact::Box;
+using RowPoints = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+// y = A X for a row-major sparse A and a dense X with `cols` columns (column-major, X.rows() =
+// A.cols()), rows on all cores; each entry is summed in the row's stored order, as Eigen does.
+void parallel_product(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, const double* x, Eigen::Index x_rows, int cols,
+                      double* y) {
+  if (!a.isCompressed()) throw std::logic_error("parallel_product: the matrix must be compressed");
+  const Eigen::Index rows = a.rows();
+  const int* outer = a.outerIndexPtr();
+  const int* inner = a.innerIndexPtr();
+  const double* value = a.valuePtr();
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, rows, 2048), [&](const tbb::blocked_range<Eigen::Index>& range) {
+    for (Eigen::Index r = range.begin(); r != range.end(); ++r)
+      for (int c = 0; c < cols; ++c) {
+        double sum = 0.0;
+        for (int k = outer[r]; k < outer[r + 1]; ++k) sum += value[k] * x[c * x_rows + inner[k]];
+        y[c * rows + r] = sum;
+      }
+  });
+}
 
 // A narrow-phase pair. Points and triangles index the collision surface ("cloth") or the
 // obstacles' combined mesh ("obstacle"); edges likewise.
@@ -167,6 +187,16 @@ struct ContactStage::Impl {
   std::vector<std::vector<int>> patch_points;      // the fine points of each patch
   std::vector<std::array<int, 3>> patch_corners;   // the surface triangle under each patch
   std::vector<std::vector<int>> near_at_rest;      // per fine triangle a: the sorted b > a near it at rest
+  std::vector<std::vector<int>> vertex_patches;    // per control node: the patches that have it as a corner
+  std::vector<std::vector<std::pair<int, int>>> control_edges;  // per control node: (neighbour, edge id)
+  size_t num_control_edges = 0;
+
+  // Scratch of the broad phase, kept for its memory.
+  RowPoints rows0, rows1;
+  std::vector<Box> scratch_point_box;
+  std::vector<std::vector<Box>> scratch_hierarchy;
+  std::vector<Eigen::Vector3d> cone_axis;
+  std::vector<double> cone_angle;
 
   // Scratch for building constraints: slot per DOF (−1 when unused).
   std::vector<int> slot;
@@ -187,7 +217,9 @@ struct ContactStage::Impl {
       throw std::invalid_argument("collision: the tolerance must be > 0 and at most 0.1");
     if (params.surface_level < 0) throw std::invalid_argument("collision: the surface level must be >= 0");
     surface = d.display(params.surface_level);
+    surface.position.makeCompressed();
     jacobian = d.point_jacobian(surface);
+    jacobian.makeCompressed();
     rest_points = d.surface_positions(surface, d.rest());
     const int n3 = 3 * d.num_nodes();
     if (static_cast<int>(free.size()) != n3 || node_mass.size() != d.num_nodes())
@@ -199,7 +231,21 @@ struct ContactStage::Impl {
     fine_per_patch = 1 << (2 * surface.levels);
     num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
     if (settings.self) find_near_at_rest();
+    if (!(settings.flat_region_angle >= 0 && settings.flat_region_angle < 0.5 * M_PI))
+      throw std::invalid_argument("collision: the flat-region angle must be >= 0 and < pi/2 [rad]");
     for (int t = 0; t < num_patches; ++t) patch_corners.push_back(d.control_triangles()[static_cast<size_t>(t)]);
+    vertex_patches.assign(static_cast<size_t>(d.num_nodes()), {});
+    for (int t = 0; t < num_patches; ++t)
+      for (int v : patch_corners[static_cast<size_t>(t)]) vertex_patches[static_cast<size_t>(v)].push_back(t);
+    control_edges.assign(static_cast<size_t>(d.num_nodes()), {});
+    for (const auto& corners : patch_corners)
+      for (int k = 0; k < 3; ++k) {
+        const int u = corners[static_cast<size_t>(k)], w = corners[static_cast<size_t>((k + 1) % 3)];
+        if (control_edge(u, w) >= 0) continue;
+        control_edges[static_cast<size_t>(u)].emplace_back(w, static_cast<int>(num_control_edges));
+        control_edges[static_cast<size_t>(w)].emplace_back(u, static_cast<int>(num_control_edges));
+        ++num_control_edges;
+      }
     patch_points.resize(static_cast<size_t>(num_patches));
     for (int t = 0; t < num_patches; ++t) {
       std::vector<int>& pts = patch_points[static_cast<size_t>(t)];
@@ -333,7 +379,8 @@ struct ContactStage::Impl {
   void update_end_points(const Eigen::VectorXd& v) {
     if (end_points_current) return;
     end_points_current = true;
-    const Eigen::VectorXd pv = jacobian * v;  // surface point velocities, flat
+    Eigen::VectorXd pv(jacobian.rows());  // surface point velocities, flat
+    parallel_product(jacobian, v.data(), v.size(), 1, pv.data());
     p1 = p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
   }
 
@@ -392,6 +439,98 @@ struct ContactStage::Impl {
     return b;
   }
 
+  // Flat regions. Over the step a fine triangle's (unnormalised) normal is the quadratic
+  // n(τ) = (1−τ)² n₀ + 2τ(1−τ) n½ + τ² n₁ in the corners' linear motion, a positive combination of
+  // n₀, n½ and n₁; so if all three lie in a cone (axis a, half-angle θ < π/2), so does n(τ) for
+  // the whole step, and n(τ)·a > 0 when n₀, n₁ ≠ 0. Per patch: a cone around the sum of its
+  // triangles' n₀ + n₁ holding every such vector (half-angle π when a triangle is degenerate at
+  // either end); per control vertex: a cone holding the cones of the patches of its star; per
+  // control edge: the smallest cone holding its two end points' cones. A star, or the union of
+  // the two stars of an edge, is flat when that cone's half-angle is below
+  // settings.flat_region_angle.
+  struct FlatRegions {
+    std::vector<char> star;  // per control vertex
+    std::vector<char> edge;  // per control edge (control_edge_ids)
+  };
+  FlatRegions flat_regions(const std::vector<Eigen::Vector3d>& axis, const std::vector<double>& angle) const {
+    FlatRegions flat;
+    flat.star.assign(vertex_patches.size(), 0);
+    flat.edge.assign(num_control_edges, 0);
+    if (!(settings.flat_region_angle > 0)) return flat;
+    std::vector<Eigen::Vector3d> star_axis(vertex_patches.size(), Eigen::Vector3d::Zero());
+    std::vector<double> star_angle(vertex_patches.size(), M_PI);
+    for (size_t v = 0; v < vertex_patches.size(); ++v) {
+      const std::vector<int>& star = vertex_patches[v];
+      Eigen::Vector3d a = Eigen::Vector3d::Zero();
+      bool open = star.empty();
+      for (int q : star) {
+        open = open || angle[static_cast<size_t>(q)] >= settings.flat_region_angle;
+        a += axis[static_cast<size_t>(q)];
+      }
+      const double length = a.norm();
+      if (open || !(length > 0)) continue;
+      a /= length;
+      double theta = 0.0;
+      for (int q : star)
+        theta = std::max(theta, std::acos(std::clamp(a.dot(axis[static_cast<size_t>(q)]), -1.0, 1.0)) + angle[static_cast<size_t>(q)]);
+      star_axis[v] = a;
+      star_angle[v] = theta;
+      flat.star[v] = theta < settings.flat_region_angle;
+    }
+    for (size_t u = 0; u < control_edges.size(); ++u)
+      for (const auto& [w, e] : control_edges[u]) {
+        if (w < static_cast<int>(u) || !flat.star[u] || !flat.star[static_cast<size_t>(w)]) continue;
+        // The smallest cone holding cones (a, α) and (b, β) at an angle φ: the larger one when it
+        // holds the other, else half-angle (φ + α + β) / 2.
+        const double alpha = star_angle[u], beta = star_angle[static_cast<size_t>(w)];
+        const double phi = std::acos(std::clamp(star_axis[u].dot(star_axis[static_cast<size_t>(w)]), -1.0, 1.0));
+        const double theta = phi + std::min(alpha, beta) <= std::max(alpha, beta) ? std::max(alpha, beta) : 0.5 * (phi + alpha + beta);
+        flat.edge[static_cast<size_t>(e)] = theta < settings.flat_region_angle;
+      }
+    return flat;
+  }
+
+  // The cone of patch q's normals over the step (see flat regions): unit axis and half-angle
+  // [rad], π when a triangle is degenerate at either end or a normal is at a right angle or more
+  // to the axis. Reads rows0 and rows1, the surface points at the start and end of the step.
+  std::pair<Eigen::Vector3d, double> patch_cone(int q, std::vector<Eigen::Vector3d>& normals) const {
+    normals.resize(static_cast<size_t>(3 * fine_per_patch));
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    bool degenerate = false;
+    for (int k = 0; k < fine_per_patch; ++k) {
+      const auto& tri = surface.triangles[static_cast<size_t>(q * fine_per_patch + k)];
+      const Eigen::Vector3d a0 = rows0.row(tri[0]), a1 = rows1.row(tri[0]);
+      const Eigen::Vector3d e0 = rows0.row(tri[1]).transpose() - a0, e1 = rows1.row(tri[1]).transpose() - a1;
+      const Eigen::Vector3d f0 = rows0.row(tri[2]).transpose() - a0, f1 = rows1.row(tri[2]).transpose() - a1;
+      Eigen::Vector3d* n = &normals[static_cast<size_t>(3 * k)];
+      n[0] = e0.cross(f0);
+      n[1] = 0.5 * (e0.cross(f1) + e1.cross(f0));
+      n[2] = e1.cross(f1);
+      if (!(n[0].squaredNorm() > 0) || !(n[2].squaredNorm() > 0)) degenerate = true;
+      sum += n[0] + n[2];
+    }
+    const double length = sum.norm();
+    if (degenerate || !(length > 0)) return {Eigen::Vector3d::Zero(), M_PI};
+    sum /= length;
+    // The smallest cos² over the vectors (no square roots); a vector at or beyond a right angle
+    // to the axis opens the cone to π.
+    double min_cos2 = 1.0;
+    for (const Eigen::Vector3d& n : normals) {
+      const double dot = n.dot(sum), norm2 = n.squaredNorm();
+      if (!(norm2 > 0)) continue;
+      if (!(dot > 0)) return {sum, M_PI};
+      min_cos2 = std::min(min_cos2, dot * dot / norm2);
+    }
+    return {sum, std::acos(std::sqrt(std::min(min_cos2, 1.0)))};
+  }
+
+  // The control edge between nodes u and w, or −1.
+  int control_edge(int u, int w) const {
+    for (const auto& [x, e] : control_edges[static_cast<size_t>(u)])
+      if (x == w) return e;
+    return -1;
+  }
+
   std::vector<Candidate> candidates(ContactReport& report) {
     const auto t0 = Clock::now();
     std::vector<Candidate> out;
@@ -401,14 +540,15 @@ struct ContactStage::Impl {
     // pairs a triangle pair stands for.
     // Swept boxes of the points first (p0 and p1 per point), then of triangles and edges as unions.
     const Eigen::Index np = p0.rows();
-    std::vector<Box> point_box(static_cast<size_t>(np));
+    rows0 = p0;  // row-major copies: the per-patch pass reads whole points
+    rows1 = p1;
+    std::vector<Box>& point_box = scratch_point_box;
+    point_box.resize(static_cast<size_t>(np));
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, np, 4096), [&](const tbb::blocked_range<Eigen::Index>& range) {
       for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
         Box& b = point_box[static_cast<size_t>(p)];
-        for (int k = 0; k < 3; ++k) {
-          b.lo[k] = std::min(p0(p, k), p1(p, k));
-          b.hi[k] = std::max(p0(p, k), p1(p, k));
-        }
+        b.lo = rows0.row(p).cwiseMin(rows1.row(p)).transpose();
+        b.hi = rows0.row(p).cwiseMax(rows1.row(p)).transpose();
       }
     });
     auto unite = [](Box a, const Box& b) {
@@ -418,24 +558,34 @@ struct ContactStage::Impl {
     };
     // A box hierarchy over the refinement: level `levels` holds the fine triangles' swept boxes,
     // level l − 1 the unions of each four children (triangle t of level l − 1 has children
-    // 4t … 4t + 3), level 0 the patches.
+    // 4t … 4t + 3), level 0 the patches. A patch's subtree is contiguous on every level, so one
+    // pass over the patches builds it, together with the patches' normal cones (self-collision).
     const int levels = surface.levels;
-    std::vector<std::vector<Box>> hierarchy(static_cast<size_t>(levels + 1));
-    hierarchy[static_cast<size_t>(levels)].resize(surface.triangles.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, surface.triangles.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t t = range.begin(); t != range.end(); ++t) {
-        const auto& tri = surface.triangles[t];
-        hierarchy[static_cast<size_t>(levels)][t] = unite(
-            unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]), point_box[static_cast<size_t>(tri[2])]);
+    std::vector<std::vector<Box>>& hierarchy = scratch_hierarchy;
+    hierarchy.resize(static_cast<size_t>(levels + 1));
+    for (int l = 0; l <= levels; ++l) hierarchy[static_cast<size_t>(l)].resize(static_cast<size_t>(num_patches) << (2 * l));
+    cone_axis.resize(static_cast<size_t>(num_patches));
+    cone_angle.resize(static_cast<size_t>(num_patches));
+    tbb::parallel_for(tbb::blocked_range<int>(0, num_patches, 256), [&](const tbb::blocked_range<int>& range) {
+      std::vector<Eigen::Vector3d> normals;
+      for (int q = range.begin(); q != range.end(); ++q) {
+        std::vector<Box>& fine = hierarchy[static_cast<size_t>(levels)];
+        for (int t = q * fine_per_patch; t < (q + 1) * fine_per_patch; ++t) {
+          const auto& tri = surface.triangles[static_cast<size_t>(t)];
+          fine[static_cast<size_t>(t)] = unite(unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]),
+                                               point_box[static_cast<size_t>(tri[2])]);
+        }
+        for (int l = levels; l > 0; --l) {
+          const std::vector<Box>& child = hierarchy[static_cast<size_t>(l)];
+          std::vector<Box>& parent = hierarchy[static_cast<size_t>(l - 1)];
+          const size_t per = size_t{1} << (2 * (l - 1));
+          for (size_t t = static_cast<size_t>(q) * per; t < static_cast<size_t>(q + 1) * per; ++t)
+            parent[t] = unite(unite(child[4 * t], child[4 * t + 1]), unite(child[4 * t + 2], child[4 * t + 3]));
+        }
+        if (settings.self && settings.flat_region_angle > 0)
+          std::tie(cone_axis[static_cast<size_t>(q)], cone_angle[static_cast<size_t>(q)]) = patch_cone(q, normals);
       }
     });
-    for (int l = levels; l > 0; --l) {
-      const std::vector<Box>& fine = hierarchy[static_cast<size_t>(l)];
-      std::vector<Box>& coarse = hierarchy[static_cast<size_t>(l - 1)];
-      coarse.resize(fine.size() / 4);
-      for (size_t t = 0; t < coarse.size(); ++t)
-        coarse[t] = unite(unite(fine[4 * t], fine[4 * t + 1]), unite(fine[4 * t + 2], fine[4 * t + 3]));
-    }
     const std::vector<Box>& tight = hierarchy[static_cast<size_t>(levels)];
     std::vector<Box> patch_box(static_cast<size_t>(num_patches));
     for (int q = 0; q < num_patches; ++q) patch_box[static_cast<size_t>(q)] = grown(hierarchy[0][static_cast<size_t>(q)], 0.5 * grow);
@@ -482,6 +632,24 @@ struct ContactStage::Impl {
             into.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb), near});
         }
     };
+    const FlatRegions flat = settings.self ? flat_regions(cone_axis, cone_angle) : FlatRegions{};
+    // Whether patches qa and qb lie in one flat region (the star of a shared vertex, or the two
+    // stars of an edge between them) whose normals stay in a cone narrower than a right angle all
+    // step: then no two points of theirs can meet (docs/contact.md, "Flat regions").
+    auto in_flat_region = [&](int qa, int qb) {
+      const auto& ca = patch_corners[static_cast<size_t>(qa)];
+      const auto& cb = patch_corners[static_cast<size_t>(qb)];
+      for (int x : ca)
+        for (int y : cb) {
+          if (x == y) {
+            if (flat.star[static_cast<size_t>(x)]) return true;
+            continue;
+          }
+          const int e = control_edge(x, y);
+          if (e >= 0 && flat.edge[static_cast<size_t>(e)]) return true;
+        }
+      return false;
+    };
     // Down the hierarchy from a pair of boxes at level l whose (grown) boxes overlap.
     struct Node {
       int level, a, b;
@@ -510,7 +678,8 @@ struct ContactStage::Impl {
     if (settings.self) {
       // Patch pairs in fixed chunks on both cores; the chunks' pairs are joined in order, so the
       // list does not depend on the threads.
-      const std::vector<std::pair<int, int>> pairs = self_broad.self_pairs(patch_box);
+      const std::vector<std::pair<int, int>> pairs =
+          self_broad.self_pairs(patch_box, [&](int qa, int qb) { return !in_flat_region(qa, qb); });
       constexpr size_t kChunk = 128;
       std::vector<std::vector<Candidate>> chunks((pairs.size() + kChunk - 1) / kChunk);
       tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
@@ -1270,7 +1439,11 @@ struct ContactStage::Impl {
     auto t0 = Clock::now();
     system_diagonal = sys.matrix.diagonal();
     const Eigen::VectorXd base = v;  // the solve's velocities, v*
-    p0 = d.surface_positions(surface, x);
+    {
+      const Eigen::MatrixX3d net = d.control_net(x);
+      p0.resize(surface.position.rows(), 3);
+      parallel_product(surface.position, net.data(), net.rows(), 3, p0.data());
+    }
     end_points_current = false;
     obstacle_boxes_current = false;
     if (!obstacle_of_vertex.empty()) {

@@ -29,6 +29,11 @@ struct CollisionSettings {
   double friction = 0.3;      // [-] Coulomb coefficient cloth–cloth, and the obstacles' default
   double tolerance = 1e-3;    // [-] of the contact response, in velocity: this fraction of the
                               // thickness per step (docs/contact.md)
+  // Not a scene key. Two patches of the collision surface in one star of a control vertex, or in
+  // the two stars of a control edge, are not tested against each other while the normals of that
+  // region stay within a cone of this half-angle [rad] over the whole step (docs/contact.md,
+  // "Flat regions"); 0 tests every pair. At least 0 and below π/2.
+  double flat_region_angle = 1.0471975511965976;  // 60°
 };
 
 struct Obstacle {
