@@ -3,6 +3,8 @@
 // scenes, the Problem.
 #include "sim/scene/scene.hpp"
 
+#include "sim/mesh/imperfection.hpp"
+
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/problem/validate.hpp"
@@ -673,6 +675,23 @@ void read_output(const Reader& r, const Json* j, Scene& scene) {
   }
 }
 
+// "imperfection": {"amplitude": m, "seed": int >= 0, "wavelength": [min, max] m}.
+Imperfection read_imperfection(const Reader& r, const Json* j) {
+  Imperfection imp;
+  if (j == nullptr) return imp;
+  r.check_object(*j, "imperfection", {"amplitude", "seed", "wavelength"});
+  imp.amplitude = r.non_negative(r.require(*j, "imperfection", "amplitude"), "imperfection.amplitude", "[m]");
+  if (const Json* v = r.find(*j, "seed")) imp.seed = static_cast<std::uint64_t>(r.integer_at_least(*v, "imperfection.seed", 0));
+  if (const Json* v = r.find(*j, "wavelength")) {
+    const Json& w = r.sized_array(*v, "imperfection.wavelength", 2, "numbers [m] (shortest, longest)");
+    imp.wavelength_min = r.positive(w[0], "imperfection.wavelength[0]", "[m]");
+    imp.wavelength_max = r.positive(w[1], "imperfection.wavelength[1]", "[m]");
+    if (imp.wavelength_min > imp.wavelength_max)
+      r.fail("imperfection.wavelength", "the shortest wavelength (first) must not exceed the longest (got " + v->dump() + ")");
+  }
+  return imp;
+}
+
 // "collision": {"self": bool, "thickness": m, "friction": -, "tolerance": -, "surface_level": int}.
 void read_collision(const Reader& r, const Json* j, Problem& problem, bool& level_given) {
   level_given = false;
@@ -911,7 +930,7 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   r.check_object(root, "",
                  {"name", "description", "analysis", "mesh", "material", "boundary", "loads", "probes",
                   "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render",
-                  "collision", "obstacles"});
+                  "collision", "obstacles", "imperfection"});
 
   Scene scene;
   scene.file = file;
@@ -951,6 +970,7 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   }
 
   scene.render = read_render(r, r.find(root, "render"));
+  const Imperfection imperfection = read_imperfection(r, r.find(root, "imperfection"));
   if (dynamic) {
     bool level_given = false;
     read_collision(r, r.find(root, "collision"), scene.problem, level_given);
@@ -969,6 +989,16 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   scene.problem.boundary = read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, dynamic, say);
   read_loads(r, r.find(root, "loads"), scene.problem, dynamic ? &dyn.ramp_time : nullptr, say);
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
+  // The boundary and probes were selected on the mesh as placed; the imperfection then changes
+  // its rest shape by at most the amplitude.
+  if (imperfection.amplitude > 0) {
+    try {
+      apply_imperfection(scene.problem.mesh, imperfection);
+    } catch (const std::exception& e) {
+      r.fail("imperfection", e.what());
+    }
+    say("imperfection: amplitude " + format_number(imperfection.amplitude) + " m, seed " + std::to_string(imperfection.seed));
+  }
 
   if (const auto issue = find_issue(scene.problem, dynamic ? Analysis::dynamics : Analysis::statics))
     r.fail(issue->key, issue->message);
