@@ -1,5 +1,6 @@
 #include "sim/setup/setup.hpp"
 
+#include "sim/flat_fe/flat_fe.hpp"
 #include "sim/forces/follower_couples.hpp"
 #include "sim/forces/point_loads.hpp"
 #include "sim/forces/surface_load.hpp"
@@ -19,16 +20,19 @@ namespace {
 
 }  // namespace
 
-std::vector<std::string> discretization_methods() { return {"loop_kl"}; }
+std::vector<std::string> discretization_methods() { return {"loop_kl", "linear_fe"}; }
 
 TriMesh prepare_mesh(const std::string& method, const TriMesh& mesh, const LogFn& log) {
   if (method == "loop_kl") return LoopShellDiscretization::prepare_mesh(mesh, log);
+  if (method == "linear_fe") return LinearFeDiscretization::prepare_mesh(mesh, log);
   unknown_method(method);
 }
 
 std::shared_ptr<Discretization> make_discretization(const Problem& problem) {
   if (problem.method == "loop_kl")
     return std::make_shared<LoopShellDiscretization>(problem.mesh, problem.boundary, problem.material, problem.quadrature);
+  if (problem.method == "linear_fe")
+    return std::make_shared<LinearFeDiscretization>(problem.mesh, problem.boundary, problem.material);
   unknown_method(problem.method);
 }
 

@@ -1,0 +1,286 @@
+#include "sim/flat_fe/flat_fe.hpp"
+
+#include "sim/flat_fe/flat_fe_term.hpp"
+#include "sim/mesh/topology.hpp"
+#include "sim/subdivision/loop.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace clothsim {
+
+namespace {
+
+// The interior edges of a consistently oriented mesh as hinges (ordered by the first triangle
+// that runs the edge, then by the edge's place in it).
+std::vector<Hinge> find_hinges(const TriMesh& mesh) {
+  std::map<std::pair<int, int>, std::pair<int, int>> directed;  // (a, b) → (triangle, apex) of the triangle running a → b
+  for (int t = 0; t < mesh.num_triangles(); ++t) {
+    const Triangle& tri = mesh.triangles[static_cast<size_t>(t)];
+    for (int k = 0; k < 3; ++k) directed[{tri[k], tri[(k + 1) % 3]}] = {t, tri[(k + 2) % 3]};
+  }
+  std::vector<Hinge> out;
+  for (int t = 0; t < mesh.num_triangles(); ++t) {
+    const Triangle& tri = mesh.triangles[static_cast<size_t>(t)];
+    for (int k = 0; k < 3; ++k) {
+      const int a = tri[k], b = tri[(k + 1) % 3];
+      const auto twin = directed.find({b, a});
+      if (twin == directed.end() || twin->second.first < t) continue;  // border edge, or listed from the twin
+      Hinge h;
+      h.nodes = {a, b, tri[(k + 2) % 3], twin->second.second};
+      h.triangle_a = t;
+      h.triangle_b = twin->second.first;
+      out.push_back(h);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+TriMesh LinearFeDiscretization::prepare_mesh(const TriMesh& mesh, const LogFn& log) {
+  check_triangles(mesh);
+  (void)Topology(mesh.num_vertices(), mesh.triangles);  // throws MeshError for a non-manifold mesh
+  if (log)
+    log("mesh: linear_fe uses the mesh as given (" + std::to_string(mesh.num_vertices()) + " vertices, " +
+        std::to_string(mesh.num_triangles()) + " triangles; no refinement)");
+  return mesh;
+}
+
+LinearFeDiscretization::LinearFeDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary,
+                                               const ShellMaterial& material)
+    : mesh_(mesh), material_(material), rest_(to_flat(mesh.vertices)),
+      status_(3 * static_cast<size_t>(mesh.num_vertices()), DofStatus::free) {
+  check_triangles(mesh_);
+  (void)Topology(mesh_.num_vertices(), mesh_.triangles);
+  for (size_t i = 0; i < boundary.size(); ++i) {
+    const BoundaryCondition& bc = boundary[i];
+    const std::string name = "linear_fe: boundary condition " + std::to_string(i);
+    if (bc.clamped || bc.symmetric)
+      throw std::runtime_error(name + ": rotation \"" + (bc.clamped ? "clamped" : "symmetry") +
+                               "\" is not supported by the linear_fe method (its nodes have no rotational degrees of "
+                               "freedom and its borders are hinged); use \"free\", or hold a slope by fixing two rows "
+                               "of vertices");
+    for (int v : bc.vertices) {
+      if (v < 0 || v >= mesh_.num_vertices())
+        throw std::runtime_error(name + ": vertex " + std::to_string(v) + " is not a vertex of the mesh");
+      for (int c = 0; c < 3; ++c)
+        if (bc.fix[static_cast<size_t>(c)]) status_[3 * static_cast<size_t>(v) + static_cast<size_t>(c)] = DofStatus::fixed;
+    }
+  }
+  hinges_ = find_hinges(mesh_);
+  std::vector<std::vector<int>> groups;
+  groups.reserve(mesh_.triangles.size() + hinges_.size());
+  for (const Triangle& t : mesh_.triangles) groups.push_back({t[0], t[1], t[2]});
+  for (const Hinge& h : hinges_) groups.push_back({h.nodes[0], h.nodes[1], h.nodes[2], h.nodes[3]});
+  blocks_ = NodeBlockPattern(mesh_.num_vertices(), groups);
+}
+
+std::vector<std::string> LinearFeDiscretization::unrestrained_rigid_motions() const {
+  // A rigid motion r = t + ω × (X − centroid)/size leaves every fixed component at rest exactly
+  // when r vanishes there. Collect r at the fixed components for the six basis motions; the
+  // null space of their Gram matrix is the rigid motions left free (the words and thresholds of
+  // ShellModel::unrestrained_rigid_motions, without its ghosts and tied components).
+  const Eigen::MatrixX3d& x = mesh_.vertices;
+  const Eigen::RowVector3d centroid = x.colwise().mean();
+  const double size = std::max((x.rowwise() - centroid).rowwise().norm().maxCoeff(), 1e-300);
+  Eigen::Matrix<double, 6, 6> gram = Eigen::Matrix<double, 6, 6>::Zero();
+  for (int v = 0; v < mesh_.num_vertices(); ++v) {
+    const Eigen::Vector3d p = (x.row(v) - centroid).transpose() / size;
+    for (int c = 0; c < 3; ++c) {
+      if (status(3 * v + c) != DofStatus::fixed) continue;
+      Eigen::Matrix<double, 6, 1> r;
+      for (int i = 0; i < 3; ++i) {
+        r(i) = i == c ? 1.0 : 0.0;
+        r(3 + i) = Eigen::Vector3d::Unit(i).cross(p)(c);
+      }
+      gram += r * r.transpose();
+    }
+  }
+  std::vector<std::string> out;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(gram);
+  const double scale = std::max(1.0, eig.eigenvalues().maxCoeff());
+  const char* axes = "xyz";
+  for (int k = 0; k < 6; ++k) {
+    if (eig.eigenvalues()(k) > 1e-9 * scale) continue;
+    const Eigen::Matrix<double, 6, 1> mode = eig.eigenvectors().col(k);
+    std::ostringstream s;
+    bool first = true;
+    for (int i = 0; i < 6; ++i) {
+      if (std::abs(mode(i)) < 1e-6) continue;
+      s << (first ? "" : " + ") << (i < 3 ? "translation along " : "rotation about ") << axes[i % 3];
+      first = false;
+    }
+    out.push_back(s.str());
+  }
+  return out;
+}
+
+Eigen::VectorXd LinearFeDiscretization::lumped_mass(double areal_density) const {
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh_.num_vertices());
+  for (const Triangle& t : mesh_.triangles) {
+    const Eigen::Vector3d x0 = mesh_.vertices.row(t[0]), x1 = mesh_.vertices.row(t[1]), x2 = mesh_.vertices.row(t[2]);
+    const double area = 0.5 * (x1 - x0).cross(x2 - x0).norm();
+    for (int v : t) mass(v) += areal_density * area / 3.0;
+  }
+  return mass;
+}
+
+Eigen::VectorXd LinearFeDiscretization::traction_load(
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d& normal)>& traction) const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(mesh_.num_vertices()));
+  for (const Triangle& t : mesh_.triangles) {
+    const Eigen::Vector3d x0 = mesh_.vertices.row(t[0]), x1 = mesh_.vertices.row(t[1]), x2 = mesh_.vertices.row(t[2]);
+    const Eigen::Vector3d n = (x1 - x0).cross(x2 - x0);
+    const double area = 0.5 * n.norm();
+    const Eigen::Vector3d share = (area / 3.0) * traction(n.normalized());  // ∫ N_I dA = A/3
+    for (int v : t) f.segment<3>(3 * v) += share;
+  }
+  return f;
+}
+
+std::unique_ptr<ForceTerm> LinearFeDiscretization::elastic_term(bool corotational, bool /*tension_stiffening*/) const {
+  return std::make_unique<LinearFeElastic>(*this, corotational);
+}
+
+SurfaceOperator LinearFeDiscretization::node_points(const std::vector<int>& nodes) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    const int v = nodes[i];
+    if (v < 0 || v >= mesh_.num_vertices())
+      throw std::out_of_range("node_points: node " + std::to_string(v) + " is not a vertex of the mesh (" +
+                              std::to_string(mesh_.num_vertices()) + " vertices)");
+    entries.emplace_back(static_cast<int>(i), v, 1.0);
+  }
+  SurfaceOperator op;
+  op.position.resize(static_cast<Eigen::Index>(nodes.size()), mesh_.num_vertices());
+  op.position.setFromTriplets(entries.begin(), entries.end());
+  return op;
+}
+
+SurfaceOperator LinearFeDiscretization::samples(const std::vector<SurfaceSample>& points) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (size_t p = 0; p < points.size(); ++p) {
+    const SurfaceSample& sp = points[p];
+    if (sp.triangle < 0 || sp.triangle >= mesh_.num_triangles())
+      throw std::invalid_argument("surface samples: point " + std::to_string(p) + " names triangle " +
+                                  std::to_string(sp.triangle) + ", not a triangle of the mesh");
+    const Triangle& t = mesh_.triangles[static_cast<size_t>(sp.triangle)];
+    const double weights[3] = {1.0 - sp.v - sp.w, sp.v, sp.w};
+    for (int k = 0; k < 3; ++k)
+      if (weights[k] != 0.0) entries.emplace_back(static_cast<int>(p), t[k], weights[k]);
+  }
+  SurfaceOperator op;
+  op.position.resize(static_cast<Eigen::Index>(points.size()), mesh_.num_vertices());
+  op.position.setFromTriplets(entries.begin(), entries.end());
+  return op;
+}
+
+SurfaceOperator LinearFeDiscretization::display(int levels) const {
+  if (levels < 0) throw std::invalid_argument("display: levels must be >= 0");
+  // Midpoint subdivision, composed: fine vertex positions = S · nodes. The topology of each step
+  // (vertex and triangle numbering, child order) is Loop's (sim/subdivision/loop.hpp); only the
+  // weights differ: old vertices stay, edge vertices are the edge midpoints.
+  using Sparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  const Eigen::Index n0 = mesh_.num_vertices();
+  Sparse s(n0, n0);
+  s.setIdentity();
+  std::vector<Triangle> tris = mesh_.triangles;
+  Eigen::MatrixX3d x = mesh_.vertices;
+  for (int level = 0; level < levels; ++level) {
+    const SubdivisionStep step = loop_subdivision_step(x, tris);
+    const Eigen::Index n = x.rows(), fine = step.matrix.rows();
+    std::vector<Eigen::Triplet<double>> w;
+    for (Eigen::Index v = 0; v < n; ++v) w.emplace_back(static_cast<int>(v), static_cast<int>(v), 1.0);
+    std::vector<char> done(static_cast<size_t>(fine), 0);
+    for (size_t t = 0; t < tris.size(); ++t) {
+      // Children: (a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca).
+      const Triangle& parent = tris[t];
+      const int ab = step.triangles[4 * t][1], ca = step.triangles[4 * t][2], bc = step.triangles[4 * t + 1][1];
+      const std::pair<int, std::pair<int, int>> mids[3] = {{ab, {parent[0], parent[1]}},
+                                                          {bc, {parent[1], parent[2]}},
+                                                          {ca, {parent[2], parent[0]}}};
+      for (const auto& [mid, ends] : mids) {
+        if (done[static_cast<size_t>(mid)]) continue;
+        done[static_cast<size_t>(mid)] = 1;
+        w.emplace_back(mid, ends.first, 0.5);
+        w.emplace_back(mid, ends.second, 0.5);
+      }
+    }
+    Sparse m(fine, n);
+    m.setFromTriplets(w.begin(), w.end());
+    s = Sparse(m * s);
+    x = m * x;
+    tris = step.triangles;
+  }
+  // Points in order of first use by the fine triangles; each takes the tangents of the surface
+  // triangle of the first fine triangle that uses it.
+  const size_t per = size_t{1} << (2 * levels);
+  std::vector<int> point_of(static_cast<size_t>(x.rows()), -1);
+  std::vector<int> used, facet;
+  SurfaceOperator op;
+  op.levels = levels;
+  op.triangles.reserve(tris.size());
+  for (size_t t = 0; t < tris.size(); ++t) {
+    Triangle ft;
+    for (int k = 0; k < 3; ++k) {
+      const int v = tris[t][static_cast<size_t>(k)];
+      if (point_of[static_cast<size_t>(v)] < 0) {
+        point_of[static_cast<size_t>(v)] = static_cast<int>(used.size());
+        used.push_back(v);
+        facet.push_back(static_cast<int>(t / per));
+      }
+      ft[static_cast<size_t>(k)] = point_of[static_cast<size_t>(v)];
+    }
+    op.triangles.push_back(ft);
+  }
+  const Eigen::Index np = static_cast<Eigen::Index>(used.size());
+  std::vector<Eigen::Triplet<double>> pick, t1, t2;
+  for (Eigen::Index p = 0; p < np; ++p) {
+    pick.emplace_back(static_cast<int>(p), used[static_cast<size_t>(p)], 1.0);
+    const Triangle& tri = mesh_.triangles[static_cast<size_t>(facet[static_cast<size_t>(p)])];
+    t1.emplace_back(static_cast<int>(p), tri[1], 1.0);
+    t1.emplace_back(static_cast<int>(p), tri[0], -1.0);
+    t2.emplace_back(static_cast<int>(p), tri[2], 1.0);
+    t2.emplace_back(static_cast<int>(p), tri[0], -1.0);
+  }
+  Sparse select(np, x.rows());
+  select.setFromTriplets(pick.begin(), pick.end());
+  op.position = select * s;
+  op.position.prune(0.0, 1e-14);
+  op.tangent1.resize(np, n0);
+  op.tangent1.setFromTriplets(t1.begin(), t1.end());
+  op.tangent2.resize(np, n0);
+  op.tangent2.setFromTriplets(t2.begin(), t2.end());
+  return op;
+}
+
+void LinearFeDiscretization::add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces,
+                                              Eigen::VectorXd& f) const {
+  // Jᵀ F: the control net is the nodes, so each point's force goes to its nodes with the
+  // operator's weights.
+  for (Eigen::Index p = 0; p < op.position.rows(); ++p)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(op.position, p); it; ++it)
+      for (int c = 0; c < 3; ++c) f(3 * it.col() + c) += it.value() * forces(p, c);
+}
+
+Eigen::SparseMatrix<double, Eigen::RowMajor> LinearFeDiscretization::point_jacobian(const SurfaceOperator& op) const {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (Eigen::Index p = 0; p < op.position.rows(); ++p)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(op.position, p); it; ++it)
+      for (int c = 0; c < 3; ++c)
+        entries.emplace_back(static_cast<int>(3 * p + c), static_cast<int>(3 * it.col() + c), it.value());
+  Eigen::SparseMatrix<double, Eigen::RowMajor> j(3 * op.position.rows(), 3 * static_cast<Eigen::Index>(mesh_.num_vertices()));
+  j.setFromTriplets(entries.begin(), entries.end());
+  return j;
+}
+
+}  // namespace clothsim
