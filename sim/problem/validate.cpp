@@ -36,6 +36,11 @@ std::optional<ProblemIssue> find_issue(const Problem& p, Analysis analysis) {
     for (int v : bc.vertices)
       if (v < 0 || v >= n) return ProblemIssue{key, "vertex " + std::to_string(v) + " is not a vertex of the mesh"};
     if (!bc.motion.empty() && !dynamic) return ProblemIssue{key + ".motion", "needs \"analysis\": \"dynamic\" (this scene is static)"};
+    if (p.method == "linear_fe" && (bc.clamped || bc.symmetric))
+      return ProblemIssue{key + ".rotation", std::string(bc.clamped ? "\"clamped\"" : "\"symmetry\"") +
+                                                " is not supported by the linear_fe method (its nodes have no rotational "
+                                                "degrees of freedom and its borders are hinged); use \"free\", or hold a "
+                                                "slope by fixing two rows of vertices"};
     if (!bc.motion.empty() && bc.clamped)
       return ProblemIssue{key + ".rotation", "\"clamped\" cannot be combined with a motion yet (the clamped border rule is "
                                              "linear in the displacement); use \"free\" (hinged)"};

@@ -928,7 +928,7 @@ namespace {
 Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::path& file, const LogFn& log) {
   const LogFn say = log ? log : LogFn([](const std::string&) {});
   r.check_object(root, "",
-                 {"name", "description", "analysis", "mesh", "material", "boundary", "loads", "probes",
+                 {"name", "description", "analysis", "method", "mesh", "material", "boundary", "loads", "probes",
                   "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render",
                   "collision", "obstacles", "imperfection"});
 
@@ -953,6 +953,9 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   if (!dynamic)
     for (const char* key : kDynamicOnlyKeys)
       if (r.find(root, key) != nullptr) r.fail(key, kNeedsDynamic);
+
+  // The discretisation: it decides how the mesh is prepared, so it is read before the mesh.
+  if (const Json* m = r.find(root, "method")) scene.problem.method = r.choice(*m, "method", discretization_methods(), "method");
 
   // Cheap checks first, the mesh (possibly large) after.
   scene.problem.material = read_material(r, r.find(root, "material"));
