@@ -313,6 +313,53 @@ TEST(LinearFeTerm, HingeEnergyOfACylinderConvergesToHalfBKappaSquaredTimesTheAre
   }
 }
 
+// The hinges' energy for a small quadratic deflection w = ε (a x² + 2c xy + b y²)/2 (constant
+// curvatures w_xx = εa, w_yy = εb, w_xy = εc) against the energy densities docs/linear_fe.md
+// derives, times the area:
+//   grid (cells split along (1, 1)):  W = B/2 [(w_xx + w_xy)² + (w_yy + w_xy)² + 4 w_xy²],
+//   equilateral lattice:              W = B/2 [(w_xx + w_yy)² − (8/3)(w_xx w_yy − w_xy²)]
+// (an isotropic plate with Poisson ratio −1/3). The difference is the border's, O(h).
+TEST(LinearFeTerm, HingeEnergyOfQuadraticDeflectionsMatchesTheDerivedDensities) {
+  const double b = 1e-4, eps = 1e-3;
+  struct Case {
+    const char* name;
+    double a, bb, c;
+  };
+  const Case cases[] = {{"paraboloid", 1, 1, 0}, {"saddle", 1, -1, 0}, {"twist", 0, 0, 1}, {"mixed", 1, 0.4, -0.3}};
+  std::printf("hinge energy of w = eps (a x^2 + 2c xy + b y^2)/2 / (W area) - 1:\n");
+  for (bool lattice : {false, true})
+    for (const Case& c : cases) {
+      const double wxx = eps * c.a, wyy = eps * c.bb, wxy = eps * c.c;
+      const double density = lattice ? 0.5 * b * ((wxx + wyy) * (wxx + wyy) - 8.0 / 3.0 * (wxx * wyy - wxy * wxy))
+                                     : 0.5 * b * ((wxx + wxy) * (wxx + wxy) + (wyy + wxy) * (wyy + wxy) + 4 * wxy * wxy);
+      std::vector<double> errors;
+      std::string row;
+      for (int n : {8, 16, 32}) {
+        TriMesh mesh = lattice ? testing::make_lattice(n + 1) : make_grid(0.1, 0.1, n, n);
+        if (lattice) mesh.vertices *= 0.1 / n;
+        const LinearFeDiscretization d(mesh, {}, material(5000.0, b));
+        double area = 0.0;
+        for (const Triangle& t : mesh.triangles)
+          area += 0.5 * (mesh.vertices.row(t[1]) - mesh.vertices.row(t[0])).cross(mesh.vertices.row(t[2]) - mesh.vertices.row(t[0])).norm();
+        Eigen::VectorXd x = d.rest();
+        for (int v = 0; v < d.num_nodes(); ++v) {
+          const double px = x(3 * v), py = x(3 * v + 1);
+          x(3 * v + 2) = 0.5 * (wxx * px * px + 2 * wxy * px * py + wyy * py * py);
+        }
+        std::unique_ptr<ForceTerm> term = d.elastic_term(true, false);
+        update_at(*term, d, x);
+        errors.push_back(as_fe(term).bending_energy() / (density * area) - 1.0);
+        char cell[64];
+        std::snprintf(cell, sizeof(cell), "  n = %2d: %+.5f", n, errors.back());
+        row += cell;
+      }
+      std::printf("  %-8s %-10s%s\n", lattice ? "lattice" : "grid", c.name, row.c_str());
+      EXPECT_LT(std::abs(errors[2]), 0.06) << c.name;
+      EXPECT_LT(std::abs(errors[2]), 0.6 * std::abs(errors[1]) + 1e-4) << c.name;
+      EXPECT_LT(std::abs(errors[1]), 0.6 * std::abs(errors[0]) + 1e-4) << c.name;
+    }
+}
+
 // The dihedral angle of one hinge: its value and sign convention, and its gradient and Hessian
 // against central differences.
 TEST(LinearFeDihedral, AngleGradientAndHessian) {
