@@ -148,7 +148,7 @@ TEST_F(SceneLoader, UnknownKeysAtAnyLevel) {
   EXPECT_EQ(error(std::string("{") + kGrid4 + R"(, "loads": {"gravty": [0, 0, -9.81]}})"),
             expected("loads.gravty: unknown key (allowed: gravity, surface_load, pressure, point_loads, moments, ramp_time)"));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "colour": "red"})"),
-                       expected("colour: unknown key (allowed: name, description, analysis, mesh")));
+                       expected("colour: unknown key (allowed: name, description, analysis, method, mesh")));
   EXPECT_TRUE(contains(error(R"({"mesh": {"primitive": "grid", "size": [1, 1], "divisions": [4, 4], "radius": 1}})"),
                        expected("mesh.radius: unknown key (allowed: primitive, size, divisions, rotate, translate)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 +
@@ -515,8 +515,9 @@ TEST_F(SceneLoader, DynamicKeysRejectedInStaticScene) {
             expected("boundary[0].motion" + needs));
   // Unknown keys are still unknown, not "dynamic only".
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "timestep": 0.01})"),
-                       expected("timestep: unknown key (allowed: name, description, analysis, mesh, material, boundary, "
-                                "loads, probes, numerics, time, damping, solver, corotational, initial, output, render, collision, obstacles)")));
+                       expected("timestep: unknown key (allowed: name, description, analysis, method, mesh, material, "
+                                "boundary, loads, probes, numerics, time, damping, solver, corotational, initial, output, "
+                                "render, collision, obstacles, imperfection)")));
 }
 
 TEST_F(SceneLoader, DynamicSettingErrors) {
