@@ -19,10 +19,11 @@
 // (sim/flat_fe/dihedral.hpp), θ̄ its rest value and
 //     k_e = B |ē|² / (2 Ā_e),
 // |ē| the rest edge length, Ā_e the sum of the two rest triangle areas, B the bending rigidity
-// [N·m]. This makes a flat regular mesh bent isometrically into a cylinder of curvature κ store
-// B κ²/2 per unit area as the mesh is refined, in any direction (derivation in docs/linear_fe.md;
-// the often quoted 3|e|²/(2A_e) is the sphere's calibration and stores three times that on a
-// cylinder). Force −2k (θ − θ̄) ∇θ; matrix 2k ∇θ ∇θᵀ (Gauss–Newton: symmetric, positive
+// [N·m]. This makes a flat mesh of equilateral triangles bent isometrically into a cylinder of
+// curvature κ store B κ²/2 per unit area as the mesh is refined, in any direction; on the grid
+// primitive's right triangles it does so across x or y, and up to 3 times that across the cells'
+// diagonal (derivation in docs/linear_fe.md; the often quoted 3|e|²/(2A_e) is the sphere's
+// calibration and stores three times B κ²/2 on a cylinder). Force −2k (θ − θ̄) ∇θ; matrix 2k ∇θ ∇θᵀ (Gauss–Newton: symmetric, positive
 // semidefinite), or with set_exact_bending_hessian(true) the exact 2k (∇θ ∇θᵀ + (θ − θ̄) ∇²θ)
 // (derivative checks).
 //
