@@ -77,7 +77,10 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
   }
   const Preconditioner factor = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor.apply(r, z); };
   const Eigen::VectorXd start = x;
-  PcgResult r = solve_pcg(a, b, free, x, s.tolerance, s.max_iterations, cholesky && m.factor.ready() ? factor : Preconditioner());
+  // With a stale factor a solve is cut off after 3 × refresh_iterations (a fresh factor is cheaper
+  // than that) and, below, refactorised and solved again.
+  const int first_limit = cholesky && m.factor.ready() ? std::min(s.max_iterations, 3 * s.refresh_iterations) : s.max_iterations;
+  PcgResult r = solve_pcg(a, b, free, x, s.tolerance, first_limit, cholesky && m.factor.ready() ? factor : Preconditioner());
   if (cholesky) {
     // The factor is of an earlier matrix, and the iterations grow as the matrix drifts from it
     // (about one more per step in the buckling sleeve). Refactor when this solve cost more than
@@ -103,7 +106,7 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
       if (m.factor.ready()) {
         report.iterations += r.iterations;
         x = start;
-        r = solve_pcg(a, b, free, x, s.tolerance, s.max_iterations, factor);
+        r = solve_pcg(a, b, free, x, s.tolerance, std::max(1, s.max_iterations - report.iterations), factor);
       }
     } else if (r.iterations > s.refresh_iterations || pays) {
       m.refactor_next = true;
