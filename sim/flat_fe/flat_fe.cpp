@@ -46,27 +46,27 @@ std::vector<Hinge> find_hinges(const TriMesh& mesh) {
 
 }  // namespace
 
-TriMesh LinearFeDiscretization::prepare_mesh(const TriMesh& mesh, const LogFn& log) {
+TriMesh FlatDiscretization::prepare_flat_mesh(const std::string& method, const TriMesh& mesh, const LogFn& log) {
   check_triangles(mesh);
   (void)Topology(mesh.num_vertices(), mesh.triangles);  // throws MeshError for a non-manifold mesh
   if (log)
-    log("mesh: linear_fe uses the mesh as given (" + std::to_string(mesh.num_vertices()) + " vertices, " +
+    log("mesh: " + method + " uses the mesh as given (" + std::to_string(mesh.num_vertices()) + " vertices, " +
         std::to_string(mesh.num_triangles()) + " triangles; no refinement)");
   return mesh;
 }
 
-LinearFeDiscretization::LinearFeDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary,
-                                               const ShellMaterial& material)
-    : mesh_(mesh), material_(material), rest_(to_flat(mesh.vertices)),
+FlatDiscretization::FlatDiscretization(std::string method, const TriMesh& mesh,
+                                       const std::vector<BoundaryCondition>& boundary, const ShellMaterial& material)
+    : method_(std::move(method)), mesh_(mesh), material_(material), rest_(to_flat(mesh.vertices)),
       status_(3 * static_cast<size_t>(mesh.num_vertices()), DofStatus::free) {
   check_triangles(mesh_);
   (void)Topology(mesh_.num_vertices(), mesh_.triangles);
   for (size_t i = 0; i < boundary.size(); ++i) {
     const BoundaryCondition& bc = boundary[i];
-    const std::string name = "linear_fe: boundary condition " + std::to_string(i);
+    const std::string name = method_ + ": boundary condition " + std::to_string(i);
     if (bc.clamped || bc.symmetric)
       throw std::runtime_error(name + ": rotation \"" + (bc.clamped ? "clamped" : "symmetry") +
-                               "\" is not supported by the linear_fe method (its nodes have no rotational degrees of "
+                               "\" is not supported by the " + method_ + " method (its nodes have no rotational degrees of "
                                "freedom and its borders are hinged); use \"free\", or hold a slope by fixing two rows "
                                "of vertices");
     for (int v : bc.vertices) {
@@ -84,7 +84,7 @@ LinearFeDiscretization::LinearFeDiscretization(const TriMesh& mesh, const std::v
   blocks_ = NodeBlockPattern(mesh_.num_vertices(), groups);
 }
 
-std::vector<std::string> LinearFeDiscretization::unrestrained_rigid_motions() const {
+std::vector<std::string> FlatDiscretization::unrestrained_rigid_motions() const {
   // A rigid motion r = t + ω × (X − centroid)/size leaves every fixed component at rest exactly
   // when r vanishes there. Collect r at the fixed components for the six basis motions; the
   // null space of their Gram matrix is the rigid motions left free (the words and thresholds of
@@ -124,7 +124,7 @@ std::vector<std::string> LinearFeDiscretization::unrestrained_rigid_motions() co
   return out;
 }
 
-Eigen::VectorXd LinearFeDiscretization::lumped_mass(double areal_density) const {
+Eigen::VectorXd FlatDiscretization::lumped_mass(double areal_density) const {
   Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh_.num_vertices());
   for (const Triangle& t : mesh_.triangles) {
     const Eigen::Vector3d x0 = mesh_.vertices.row(t[0]), x1 = mesh_.vertices.row(t[1]), x2 = mesh_.vertices.row(t[2]);
@@ -134,7 +134,7 @@ Eigen::VectorXd LinearFeDiscretization::lumped_mass(double areal_density) const 
   return mass;
 }
 
-Eigen::VectorXd LinearFeDiscretization::traction_load(
+Eigen::VectorXd FlatDiscretization::traction_load(
     const std::function<Eigen::Vector3d(const Eigen::Vector3d& normal)>& traction) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(mesh_.num_vertices()));
   for (const Triangle& t : mesh_.triangles) {
@@ -151,7 +151,7 @@ std::unique_ptr<ForceTerm> LinearFeDiscretization::elastic_term(bool corotationa
   return std::make_unique<LinearFeElastic>(*this, corotational);
 }
 
-SurfaceOperator LinearFeDiscretization::node_points(const std::vector<int>& nodes) const {
+SurfaceOperator FlatDiscretization::node_points(const std::vector<int>& nodes) const {
   std::vector<Eigen::Triplet<double>> entries;
   for (size_t i = 0; i < nodes.size(); ++i) {
     const int v = nodes[i];
@@ -166,7 +166,7 @@ SurfaceOperator LinearFeDiscretization::node_points(const std::vector<int>& node
   return op;
 }
 
-SurfaceOperator LinearFeDiscretization::samples(const std::vector<SurfaceSample>& points) const {
+SurfaceOperator FlatDiscretization::samples(const std::vector<SurfaceSample>& points) const {
   std::vector<Eigen::Triplet<double>> entries;
   for (size_t p = 0; p < points.size(); ++p) {
     const SurfaceSample& sp = points[p];
@@ -184,7 +184,7 @@ SurfaceOperator LinearFeDiscretization::samples(const std::vector<SurfaceSample>
   return op;
 }
 
-SurfaceOperator LinearFeDiscretization::display(int levels) const {
+SurfaceOperator FlatDiscretization::display(int levels) const {
   if (levels < 0) throw std::invalid_argument("display: levels must be >= 0");
   // Midpoint subdivision, composed: fine vertex positions = S · nodes. The topology of each step
   // (vertex and triangle numbering, child order) is Loop's (sim/subdivision/loop.hpp); only the
@@ -263,7 +263,7 @@ SurfaceOperator LinearFeDiscretization::display(int levels) const {
   return op;
 }
 
-void LinearFeDiscretization::add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces,
+void FlatDiscretization::add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces,
                                               Eigen::VectorXd& f) const {
   // Jᵀ F: the control net is the nodes, so each point's force goes to its nodes with the
   // operator's weights.
@@ -272,7 +272,7 @@ void LinearFeDiscretization::add_point_forces(const SurfaceOperator& op, const E
       for (int c = 0; c < 3; ++c) f(3 * it.col() + c) += it.value() * forces(p, c);
 }
 
-Eigen::SparseMatrix<double, Eigen::RowMajor> LinearFeDiscretization::point_jacobian(const SurfaceOperator& op) const {
+Eigen::SparseMatrix<double, Eigen::RowMajor> FlatDiscretization::point_jacobian(const SurfaceOperator& op) const {
   std::vector<Eigen::Triplet<double>> entries;
   for (Eigen::Index p = 0; p < op.position.rows(); ++p)
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(op.position, p); it; ++it)

@@ -1,11 +1,16 @@
-// The baseline the paper compares against, method "linear_fe": piecewise-linear (flat) triangles
-// whose nodes are the mesh vertices, with
-//  - membrane: constant-strain triangles in plane stress, corotated per triangle (Etzmuss,
-//    Keckeisen & Straßer 2003);
-//  - bending: dihedral-angle hinges on the interior edges (discrete shells, Grinspun et al. 2003;
-//    hinge bending in cloth, Bridson, Marino & Fedkiw 2003).
-// The force term is sim/flat_fe/flat_fe_term.hpp; docs/linear_fe.md has the formulation, the
-// calibration of the hinges and the limitations.
+// The piecewise-flat discretisation shared by two methods (docs/linear_fe.md, docs/mass_spring.md):
+// flat triangles whose nodes are the mesh vertices. FlatDiscretization holds everything the two
+// have in common — nodes, DOFs, mass, loads, the matrix pattern, hinges and the surface operators —
+// and each method adds its elastic force term:
+//  - "linear_fe" (LinearFeDiscretization), the baseline the paper compares against:
+//    - membrane: constant-strain triangles in plane stress, corotated per triangle (Etzmuss,
+//      Keckeisen & Straßer 2003);
+//    - bending: dihedral-angle hinges on the interior edges (discrete shells, Grinspun et al.
+//      2003; hinge bending in cloth, Bridson, Marino & Fedkiw 2003).
+//    Its force term is sim/flat_fe/flat_fe_term.hpp; docs/linear_fe.md has the formulation, the
+//    calibration of the hinges and the limitations.
+//  - "mass_spring" (sim/flat_fe/mass_spring.hpp): linear springs on the edges and across the
+//    hinges, the way popular cloth tools model cloth (docs/mass_spring.md).
 //
 // Nodes and DOFs: the mesh vertices, 3 DOFs each, free or fixed (the boundary conditions' fixed
 // components; a scripted `motion` of fixed components is the integrator's, as for loop_kl). No DOF
@@ -21,6 +26,7 @@
 #include "sim/shell/material.hpp"
 
 #include <array>
+#include <string>
 #include <vector>
 
 namespace clothsim {
@@ -32,19 +38,16 @@ struct Hinge {
   int triangle_a = -1, triangle_b = -1;  // indices into the mesh's triangles
 };
 
-class LinearFeDiscretization final : public Discretization {
+// The shared part: a Discretization without its elastic term.
+class FlatDiscretization : public Discretization {
  public:
   // The mesh as given, checked (check_triangles, and a manifold, consistently oriented topology
-  // without isolated vertices: sim/mesh/topology.hpp); no refinement. Logs that. Throws
-  // MeshError naming the element.
-  static TriMesh prepare_mesh(const TriMesh& mesh, const LogFn& log);
+  // without isolated vertices: sim/mesh/topology.hpp); no refinement. Logs that, naming `method`.
+  // Throws MeshError naming the element.
+  static TriMesh prepare_flat_mesh(const std::string& method, const TriMesh& mesh, const LogFn& log);
 
-  // `boundary` holds vertex ids of `mesh`. Throws MeshError for an invalid mesh and
-  // std::runtime_error for a boundary condition it cannot take (a clamped or symmetry border, a
-  // vertex out of range), naming the condition.
-  LinearFeDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary, const ShellMaterial& material);
-
-  std::string method() const override { return "linear_fe"; }
+  // The method's name as in the scene format ("linear_fe", "mass_spring").
+  std::string method() const override { return method_; }
   const TriMesh& mesh() const override { return mesh_; }
   const Eigen::VectorXd& rest() const override { return rest_; }
   DofStatus status(int dof) const override { return status_[static_cast<size_t>(dof)]; }
@@ -57,10 +60,6 @@ class LinearFeDiscretization final : public Discretization {
   // gets each triangle's rest unit normal (constant over it), so f_I = Σ (A/3) t(n) over I's
   // triangles, exact.
   Eigen::VectorXd traction_load(const std::function<Eigen::Vector3d(const Eigen::Vector3d& normal)>& traction) const override;
-  // The corotated (or, `corotational` false, linear) membrane plus the hinge bending
-  // (LinearFeElastic). `tension_stiffening` is ignored: the method has no geometric stiffness
-  // term (docs/linear_fe.md).
-  std::unique_ptr<ForceTerm> elastic_term(bool corotational, bool tension_stiffening) const override;
   // 3 × 3 blocks for every pair of nodes sharing a triangle or a hinge.
   const Eigen::SparseMatrix<double>& matrix_pattern() const override { return blocks_.pattern(); }
 
@@ -83,20 +82,44 @@ class LinearFeDiscretization final : public Discretization {
   void add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces, Eigen::VectorXd& f) const override;
   Eigen::SparseMatrix<double, Eigen::RowMajor> point_jacobian(const SurfaceOperator& op) const override;
 
-  // For the force term and its tests.
+  // For the force terms and their tests.
   const ShellMaterial& material() const { return material_; }
   const std::vector<Hinge>& hinges() const { return hinges_; }
   // The pattern's groups: triangle t is group t, hinge h is group #triangles + h (its nodes in
   // Hinge::nodes order).
   const NodeBlockPattern& blocks() const { return blocks_; }
 
+ protected:
+  // `method` names the method in messages. `boundary` holds vertex ids of `mesh`. Throws
+  // MeshError for an invalid mesh and std::runtime_error for a boundary condition it cannot take
+  // (a clamped or symmetry border, a vertex out of range), naming the condition and the method.
+  FlatDiscretization(std::string method, const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary,
+                     const ShellMaterial& material);
+
  private:
+  std::string method_;
   TriMesh mesh_;
   ShellMaterial material_;
   Eigen::VectorXd rest_;
   std::vector<DofStatus> status_;  // 3 per node
   std::vector<Hinge> hinges_;
   NodeBlockPattern blocks_;
+};
+
+// The baseline "linear_fe": corotated constant-strain membrane and hinge bending.
+class LinearFeDiscretization final : public FlatDiscretization {
+ public:
+  // FlatDiscretization::prepare_flat_mesh for "linear_fe".
+  static TriMesh prepare_mesh(const TriMesh& mesh, const LogFn& log) { return prepare_flat_mesh("linear_fe", mesh, log); }
+
+  // See FlatDiscretization's constructor.
+  LinearFeDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary, const ShellMaterial& material)
+      : FlatDiscretization("linear_fe", mesh, boundary, material) {}
+
+  // The corotated (or, `corotational` false, linear) membrane plus the hinge bending
+  // (LinearFeElastic). `tension_stiffening` is ignored: the method has no geometric stiffness
+  // term (docs/linear_fe.md).
+  std::unique_ptr<ForceTerm> elastic_term(bool corotational, bool tension_stiffening) const override;
 };
 
 }  // namespace clothsim
