@@ -4,8 +4,9 @@
 // from the control DOFs to points of the surface (probes, OBJ frames, rendering, the studies'
 // sampling, point loads, and collision geometry). The integrator, the outputs and the renderer
 // adapter see only this interface; the Loop-subdivision Kirchhoff–Love shell
-// (sim/loop_shell/loop_shell.hpp) is one implementation, the piecewise-flat baseline "linear_fe"
-// (sim/flat_fe/flat_fe.hpp: linear triangles with hinge bending) another.
+// (sim/loop_shell/loop_shell.hpp) is one implementation; the piecewise-flat discretisation
+// (sim/flat_fe/flat_fe.hpp) serves two more, the baseline "linear_fe" (linear triangles with hinge
+// bending) and "mass_spring" (edge and bending springs, sim/flat_fe/mass_spring.hpp).
 //
 // Nodes and DOFs. The discretisation has #nodes nodes (for the Loop shell: the control vertices of
 // the prepared mesh) with 3 DOFs each, flat as in sim/core/layout.hpp. Each DOF is free (an
@@ -60,7 +61,7 @@ class Discretization {
  public:
   virtual ~Discretization() = default;
 
-  // The method's name as in the scene format ("loop_kl", "linear_fe").
+  // The method's name as in the scene format ("loop_kl", "linear_fe", "mass_spring").
   virtual std::string method() const = 0;
 
   // --- Nodes and DOFs -------------------------------------------------------------------------

@@ -54,8 +54,9 @@ struct InitialState {
 
 struct Problem {
   // The discretisation (sim/setup/setup.hpp: discretization_methods): "loop_kl", the Loop-
-  // subdivision Kirchhoff–Love shell, or "linear_fe", flat corotated membrane triangles with hinge
-  // bending (the baseline).
+  // subdivision Kirchhoff–Love shell, "linear_fe", flat corotated membrane triangles with hinge
+  // bending (the baseline), or "mass_spring", edge and bending springs on the flat triangles
+  // (dynamic analyses only).
   std::string method = "loop_kl";
   TriMesh mesh;  // control mesh, prepared for the method (sim/setup/setup.hpp: prepare_mesh)
   ShellMaterial material;

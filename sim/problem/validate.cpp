@@ -30,15 +30,22 @@ std::optional<ProblemIssue> find_issue(const Problem& p, Analysis analysis) {
   if (dynamic && !(p.material.areal_density > 0))
     return ProblemIssue{"material", "a dynamic analysis needs a positive areal density (mass) [kg/m²] (got " +
                                         format_number(p.material.areal_density) + ")"};
+  // A flat spring network has no stiffness against out-of-plane displacements at rest, so the
+  // linear statics of a flat sheet under a transverse load would be singular (docs/mass_spring.md).
+  if (!dynamic && p.method == "mass_spring")
+    return ProblemIssue{"method", "\"mass_spring\" needs \"analysis\": \"dynamic\": a spring's length changes only at "
+                                  "second order when its ends move across it, so a flat spring network has no stiffness "
+                                  "against out-of-plane displacements at rest and a linear static analysis has no answer; "
+                                  "run the scene as a dynamic one with damping"};
   for (size_t i = 0; i < p.boundary.size(); ++i) {
     const BoundaryCondition& bc = p.boundary[i];
     const std::string key = index_key("boundary", i);
     for (int v : bc.vertices)
       if (v < 0 || v >= n) return ProblemIssue{key, "vertex " + std::to_string(v) + " is not a vertex of the mesh"};
     if (!bc.motion.empty() && !dynamic) return ProblemIssue{key + ".motion", "needs \"analysis\": \"dynamic\" (this scene is static)"};
-    if (p.method == "linear_fe" && (bc.clamped || bc.symmetric))
+    if ((p.method == "linear_fe" || p.method == "mass_spring") && (bc.clamped || bc.symmetric))
       return ProblemIssue{key + ".rotation", std::string(bc.clamped ? "\"clamped\"" : "\"symmetry\"") +
-                                                " is not supported by the linear_fe method (its nodes have no rotational "
+                                                " is not supported by the " + p.method + " method (its nodes have no rotational "
                                                 "degrees of freedom and its borders are hinged); use \"free\", or hold a "
                                                 "slope by fixing two rows of vertices"};
     if (!bc.motion.empty() && bc.clamped)

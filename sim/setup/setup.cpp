@@ -1,6 +1,7 @@
 #include "sim/setup/setup.hpp"
 
 #include "sim/flat_fe/flat_fe.hpp"
+#include "sim/flat_fe/mass_spring.hpp"
 #include "sim/forces/follower_couples.hpp"
 #include "sim/forces/point_loads.hpp"
 #include "sim/forces/surface_load.hpp"
@@ -20,11 +21,12 @@ namespace {
 
 }  // namespace
 
-std::vector<std::string> discretization_methods() { return {"loop_kl", "linear_fe"}; }
+std::vector<std::string> discretization_methods() { return {"loop_kl", "linear_fe", "mass_spring"}; }
 
 TriMesh prepare_mesh(const std::string& method, const TriMesh& mesh, const LogFn& log) {
   if (method == "loop_kl") return LoopShellDiscretization::prepare_mesh(mesh, log);
   if (method == "linear_fe") return LinearFeDiscretization::prepare_mesh(mesh, log);
+  if (method == "mass_spring") return MassSpringDiscretization::prepare_mesh(mesh, log);
   unknown_method(method);
 }
 
@@ -33,6 +35,8 @@ std::shared_ptr<Discretization> make_discretization(const Problem& problem) {
     return std::make_shared<LoopShellDiscretization>(problem.mesh, problem.boundary, problem.material, problem.quadrature);
   if (problem.method == "linear_fe")
     return std::make_shared<LinearFeDiscretization>(problem.mesh, problem.boundary, problem.material);
+  if (problem.method == "mass_spring")
+    return std::make_shared<MassSpringDiscretization>(problem.mesh, problem.boundary, problem.material);
   unknown_method(problem.method);
 }
 

@@ -19,14 +19,16 @@
 namespace clothsim {
 
 // The discretisation methods a problem can name (Problem::method): "loop_kl" (the Loop-subdivision
-// Kirchhoff–Love shell, sim/loop_shell/) and "linear_fe" (flat corotated membrane triangles with
-// hinge bending, the baseline: sim/flat_fe/).
+// Kirchhoff–Love shell, sim/loop_shell/), "linear_fe" (flat corotated membrane triangles with
+// hinge bending, the baseline: sim/flat_fe/flat_fe.hpp) and "mass_spring" (edge and bending springs
+// on the same flat triangles: sim/flat_fe/mass_spring.hpp).
 std::vector<std::string> discretization_methods();
 
 // The mesh `method` needs, made from `mesh` (for "loop_kl": refined once by Loop subdivision when
-// a triangle has two irregular vertices; for "linear_fe": the mesh itself, checked); logs what it
-// did. Boundary selections and probes refer to the prepared mesh's vertices. Throws std::invalid_argument for an unknown method and
-// MeshError for an invalid mesh (naming the element).
+// a triangle has two irregular vertices; for "linear_fe" and "mass_spring": the mesh itself,
+// checked); logs what it did. Boundary selections and probes refer to the prepared mesh's
+// vertices. Throws std::invalid_argument for an unknown method and MeshError for an invalid mesh
+// (naming the element).
 TriMesh prepare_mesh(const std::string& method, const TriMesh& mesh, const LogFn& log);
 
 // The discretisation of the problem's (prepared) mesh, boundary conditions, material and

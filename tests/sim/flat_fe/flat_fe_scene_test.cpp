@@ -53,9 +53,9 @@ TEST_F(MethodKey, LinearFeUsesTheMeshAsGiven) {
 
 TEST_F(MethodKey, UnknownMethodIsAnErrorListingTheAllowedOnes) {
   EXPECT_EQ(error(std::string(R"({"method": "fem", )") + kGrid4 + "}"),
-            expected(R"(method: unknown method "fem" (allowed: "loop_kl", "linear_fe"))"));
+            expected(R"(method: unknown method "fem" (allowed: "loop_kl", "linear_fe", "mass_spring"))"));
   EXPECT_EQ(error(std::string(R"({"method": 3, )") + kGrid4 + "}"),
-            expected(R"(method: expected a string (got 3; allowed: "loop_kl", "linear_fe"))"));
+            expected(R"(method: expected a string (got 3; allowed: "loop_kl", "linear_fe", "mass_spring"))"));
 }
 
 TEST_F(MethodKey, LinearFeRefusesClampedAndSymmetryBorders) {
