@@ -1,12 +1,15 @@
-// Small meshes built for tests: a regular triangular lattice and a "fan disc" whose centre has
-// any valence, with every other interior vertex regular.
+// Small meshes built for tests: a regular triangular lattice, a "fan disc" whose centre has any
+// valence, with every other interior vertex regular, and a grid with jittered interior vertices;
+// and the area of a mesh.
 #pragma once
 
+#include "sim/mesh/generators.hpp"
 #include "sim/mesh/mesh.hpp"
 
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <random>
 
 namespace clothsim::testing {
 
@@ -22,6 +25,13 @@ inline TriMesh make_lattice(int n) {
       m.triangles.push_back({p, p + 1, p + n});
       m.triangles.push_back({p + 1, p + n + 1, p + n});
     }
+  return m;
+}
+
+// The same lattice of n × n points scaled to `side` [m] in total along x.
+inline TriMesh make_lattice(int n, double side) {
+  TriMesh m = make_lattice(n);
+  m.vertices *= side / (n - 1);
   return m;
 }
 
@@ -53,6 +63,29 @@ inline TriMesh make_fan_disc(int sectors, int k) {
   m.vertices.resize(static_cast<Eigen::Index>(pts.size()), 3);
   for (size_t i = 0; i < pts.size(); ++i) m.vertices.row(static_cast<Eigen::Index>(i)) = pts[i];
   return m;
+}
+
+// A 0.1 m × 0.08 m grid (5 × 4 cells) whose interior vertices are moved in the plane by up to 15 %
+// of a cell (seeded): triangles of many shapes, still a valid mesh.
+inline TriMesh jittered_grid() {
+  TriMesh m = make_grid(0.1, 0.08, 5, 4);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.003, 0.003);
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const double x = m.vertices(v, 0), y = m.vertices(v, 1);
+    if (std::abs(std::abs(x) - 0.05) < 1e-9 || std::abs(std::abs(y) - 0.04) < 1e-9) continue;
+    m.vertices(v, 0) += u(rng);
+    m.vertices(v, 1) += u(rng);
+  }
+  return m;
+}
+
+// The sum of the triangles' areas [m²].
+inline double mesh_area(const TriMesh& m) {
+  double area = 0.0;
+  for (const Triangle& t : m.triangles)
+    area += 0.5 * (m.vertices.row(t[1]) - m.vertices.row(t[0])).cross(m.vertices.row(t[2]) - m.vertices.row(t[0])).norm();
+  return area;
 }
 
 }  // namespace clothsim::testing

@@ -7,9 +7,8 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/setup/setup.hpp"
 #include "sim/static/static_solve.hpp"
+#include "tests/support/analysis_runs.hpp"
 
-#include <Eigen/LU>
-#include <Eigen/SVD>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,6 +18,9 @@
 
 namespace clothsim {
 namespace {
+
+using testing::mid_deflection;
+using testing::rigid_residual;
 
 constexpr double kLength = 0.2, kWidth = 0.04;  // strip [m], along x and y, centred at the origin
 
@@ -40,18 +42,6 @@ Problem strip(int n, double bending_rigidity) {
   right.fix = {false, true, true};
   p.boundary = {left, right};
   return p;
-}
-
-// Mean z displacement of the nodes on the strip's middle line x = 0 [m] (#nodes × 3 displacements).
-double mid_deflection(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3d& displacement) {
-  double sum = 0.0;
-  int count = 0;
-  for (Eigen::Index v = 0; v < rest.rows(); ++v)
-    if (std::abs(rest(v, 0)) < 1e-9) {
-      sum += displacement(v, 2);
-      ++count;
-    }
-  return sum / count;
 }
 
 // A long plate (L = 10 W) hinged on all four edges under a uniform load q bends cylindrically
@@ -148,19 +138,9 @@ TEST(LinearFeAnalysis, DampedStripUnderGravitySettlesOnItsStaticDeflection) {
   p.solver.type = LinearSolverType::cholmod;
   Simulator sim(p);
   EXPECT_EQ(sim.discretization().method(), "linear_fe");
-  double peak_kinetic = 0.0, lowest_balance = 0.0, deepest = 0.0;
-  for (int i = 0; i < sim.num_steps(); ++i) {
-    sim.step();
-    ASSERT_TRUE(sim.state().x.allFinite()) << "step " << i;
-    peak_kinetic = std::max(peak_kinetic, sim.kinetic_energy());
-    // Dissipated so far = work in − energy stored; it must never be negative.
-    const double dissipated = sim.external_work() + sim.boundary_work() - sim.kinetic_energy() - sim.elastic_energy();
-    lowest_balance = std::min(lowest_balance, dissipated / std::max(sim.external_work(), 1e-300));
-    const Eigen::MatrixX3d u = sim.node_points() - sim.node_points_rest();
-    deepest = std::max(deepest, -mid_deflection(sim.node_points_rest(), u));
-  }
-  const Eigen::MatrixX3d u = sim.node_points() - sim.node_points_rest();
-  const double w = -mid_deflection(sim.node_points_rest(), u);
+  testing::DampedRun run;
+  ASSERT_NO_FATAL_FAILURE(testing::run_to_the_end(sim, run));
+  const auto [peak_kinetic, lowest_balance, deepest, w] = run;
   const double beam = 5.0 * p.material.areal_density * 9.81 * std::pow(kLength, 4) / (384.0 * b);
   std::printf("damped strip after %.2f s: mid deflection %.6e m (deepest %.6e m), static linear_fe %.6e m (%+.2e), "
               "beam %.6e m; kinetic energy %.2e J (peak %.2e J), energy balance >= %.2e of the work\n",
@@ -171,36 +151,10 @@ TEST(LinearFeAnalysis, DampedStripUnderGravitySettlesOnItsStaticDeflection) {
   EXPECT_GT(lowest_balance, -1e-9);                    // no energy created
 }
 
-// RMS distance between x and the best rigid image of rest (Kabsch), relative to the size.
-double rigid_residual(const Eigen::MatrixX3d& rest, const Eigen::MatrixX3d& x) {
-  const Eigen::RowVector3d c0 = rest.colwise().mean(), c1 = x.colwise().mean();
-  const Eigen::MatrixX3d a = rest.rowwise() - c0, bm = x.rowwise() - c1;
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(a.transpose() * bm, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d r = svd.matrixV() * svd.matrixU().transpose();
-  if (r.determinant() < 0) {
-    Eigen::Matrix3d fix = Eigen::Matrix3d::Identity();
-    fix(2, 2) = -1;
-    r = svd.matrixV() * fix * svd.matrixU().transpose();
-  }
-  return std::sqrt(((a * r.transpose()) - bm).rowwise().squaredNorm().mean()) / a.rowwise().norm().maxCoeff();
-}
-
 // A free sleeve spun at 10 rad/s about its axis for 0.3 s (three Newton iterations per step, as
 // the loop_kl test): the corotated element keeps it rigid, the linear one distorts it.
 TEST(LinearFeAnalysis, SpinningFreeSleeveStaysUndeformed) {
-  Problem p;
-  p.method = "linear_fe";
-  p.mesh = make_cylinder(0.05, 0.2, 12, 7);
-  p.material.stretch_modulus = 1e5;
-  p.material.bending_rigidity = 1e-4;
-  p.material.poisson_ratio = 0.25;
-  p.material.areal_density = 0.1;
-  p.initial.angular_velocity = Eigen::Vector3d(0, 10.0, 0);
-  p.initial.center = Eigen::Vector3d(0, 0.1, 0);
-  p.time.dt = 1e-3;
-  p.time.end = 0.3;
-  p.solver.type = LinearSolverType::cholmod;
-  p.solver.newton_iterations = 3;
+  Problem p = testing::spinning_sleeve("linear_fe");
   double residuals[2] = {0.0, 0.0};
   for (bool corotational : {true, false}) {
     p.corotational = corotational;

@@ -5,9 +5,10 @@
 // the dihedral angle itself, and the matrix pattern.
 #include "sim/flat_fe/flat_fe.hpp"
 #include "sim/flat_fe/flat_fe_term.hpp"
-#include "sim/forces/damping.hpp"
 #include "sim/mesh/generators.hpp"
 #include "tests/support/fd_check.hpp"
+#include "tests/support/flat_terms.hpp"
+#include "tests/support/term_states.hpp"
 #include "tests/support/test_meshes.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -25,101 +26,30 @@
 namespace clothsim {
 namespace {
 
-using testing::check_force_against_energy;
+using testing::bent_into_cylinder;
 using testing::check_matrix_against_force;
+using testing::energy_at;
 using testing::FdReport;
 using testing::force_at;
+using testing::jittered_grid;
 using testing::matrix_at;
+using testing::mesh_area;
+using testing::rigidly_moved;
+using testing::rotation;
+using testing::sheet_material;
+using testing::State;
+using testing::states;
 using testing::update_at;
 
 constexpr double kEps = 1e-6;  // finite-difference step [m]
 
-ShellMaterial material(double stretch_modulus, double bending_rigidity) {
-  ShellMaterial m;
-  m.stretch_modulus = stretch_modulus;
-  m.bending_rigidity = bending_rigidity;
-  m.poisson_ratio = 0.3;
-  m.areal_density = 0.12;
-  return m;
-}
-
-// A 0.1 m × 0.08 m grid (5 × 4 cells) whose interior vertices are moved in the plane by up to 15 %
-// of a cell (seeded): triangles of many shapes, still a valid mesh.
-TriMesh jittered_grid() {
-  TriMesh m = make_grid(0.1, 0.08, 5, 4);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-0.003, 0.003);
-  for (int v = 0; v < m.num_vertices(); ++v) {
-    const double x = m.vertices(v, 0), y = m.vertices(v, 1);
-    if (std::abs(std::abs(x) - 0.05) < 1e-9 || std::abs(std::abs(y) - 0.04) < 1e-9) continue;
-    m.vertices(v, 0) += u(rng);
-    m.vertices(v, 1) += u(rng);
-  }
-  return m;
-}
-
-Eigen::Matrix3d rotation(double angle, const Eigen::Vector3d& axis) {
-  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-}
-
-Eigen::VectorXd rigidly_moved(const Discretization& d, const Eigen::VectorXd& x0, const Eigen::Matrix3d& r,
-                              const Eigen::Vector3d& c) {
-  Eigen::VectorXd x = x0;
-  for (int v = 0; v < d.num_nodes(); ++v) x.segment<3>(3 * v) = r * x0.segment<3>(3 * v) + c;
-  return x;
-}
-
-struct State {
-  std::string name;
-  Eigen::VectorXd x;
-};
-
-// Rest, seeded random states (about 10 % of a cell), a strong in-plane compression, a fold by 150°
-// and a large rotation with strain.
-std::vector<State> states(const Discretization& d) {
-  std::vector<State> out;
-  out.push_back({"rest", d.rest()});
-  for (unsigned seed : {1u, 2u}) out.push_back({"random " + std::to_string(seed), testing::perturbed_rest(d, 2e-3, seed)});
-  Eigen::VectorXd compressed = testing::perturbed_rest(d, 2e-4, 7);
-  for (int v = 0; v < d.num_nodes(); ++v) compressed(3 * v) *= 0.7;
-  out.push_back({"compressed 30 %", compressed});
-  Eigen::VectorXd folded = testing::perturbed_rest(d, 2e-4, 11);
-  const Eigen::Matrix3d fold = rotation(150.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
-  for (int v = 0; v < d.num_nodes(); ++v)
-    if (folded(3 * v) > 0.001) folded.segment<3>(3 * v) = fold * folded.segment<3>(3 * v);
-  out.push_back({"folded 150 deg", folded});
-  Eigen::VectorXd turned = rigidly_moved(d, d.rest(), rotation(1.2, Eigen::Vector3d(1, 2, -0.5)), Eigen::Vector3d(0.01, -0.02, 0.03));
-  turned += testing::perturbed_rest(d, 1e-3, 13) - d.rest();
-  out.push_back({"large rotation", turned});
-  return out;
-}
-
-struct Structure {
-  std::string name;
-  std::unique_ptr<LinearFeDiscretization> d;
-};
+using Structure = testing::Structure<LinearFeDiscretization>;
 
 // The jittered grid (flat at rest) and a short sleeve (curved at rest: every hinge has θ̄ ≠ 0),
-// each in three materials so that each part is checked where it dominates the force.
-std::vector<Structure> structures() {
-  std::vector<Structure> out;
-  const std::pair<std::string, ShellMaterial> materials[] = {{"cloth", material(5000.0, 1e-4)},
-                                                             {"bending only", material(1e-6, 1e-4)},
-                                                             {"membrane only", material(5000.0, 1e-12)}};
-  for (const auto& [name, m] : materials) {
-    out.push_back({"grid, " + name, std::make_unique<LinearFeDiscretization>(jittered_grid(), std::vector<BoundaryCondition>{}, m)});
-    out.push_back({"sleeve, " + name, std::make_unique<LinearFeDiscretization>(make_cylinder(0.03, 0.06, 8, 4),
-                                                                                 std::vector<BoundaryCondition>{}, m)});
-  }
-  return out;
-}
+// each in three materials so that the membrane and the hinges are each checked where they dominate.
+std::vector<Structure> structures() { return testing::grid_and_sleeve<LinearFeDiscretization>("membrane only"); }
 
 LinearFeElastic& as_fe(std::unique_ptr<ForceTerm>& term) { return dynamic_cast<LinearFeElastic&>(*term); }
-
-double energy_of(ForceTerm& term, const Discretization& d, const Eigen::VectorXd& x) {
-  update_at(term, d, x);
-  return term.energy();
-}
 
 // f = −∂E/∂x with the rotations re-extracted at every perturbed state (the polar rotation makes
 // −R K d the exact gradient), for the corotated and the linear element. At rest, where the force is
@@ -128,16 +58,9 @@ TEST(LinearFeTerm, ForceIsTheGradientOfTheEnergy) {
   double worst = 0.0;
   for (const Structure& s : structures())
     for (bool corotational : {true, false}) {
-      const std::vector<State> all = states(*s.d);
       std::unique_ptr<ForceTerm> term = s.d->elastic_term(corotational, true);
-      const double floor = force_at(*term, *s.d, all[1].x).cwiseAbs().maxCoeff();
-      for (const State& state : all) {
-        FdReport r = check_force_against_energy(*term, *s.d, state.x, kEps);
-        r.floor = floor;
-        worst = std::max(worst, r.relative());
-        EXPECT_LT(r.relative(), 1e-6) << s.name << (corotational ? ", corotated, " : ", linear, ") << state.name << ": "
-                                      << r.describe();
-      }
+      worst = std::max(worst, testing::expect_force_is_the_gradient(*term, *s.d, states(*s.d), kEps,
+                                                                    s.name + (corotational ? ", corotated" : ", linear")));
     }
   std::printf("linear_fe force vs energy: worst relative error %.2e over %zu structures x 2 x 6 states\n", worst,
               structures().size());
@@ -192,8 +115,8 @@ TEST(LinearFeTerm, RigidMotionsStoreNoEnergyAndMakeNoForce) {
     const Discretization& d = *s.d;
     std::unique_ptr<ForceTerm> corotated = d.elastic_term(true, true), linear = d.elastic_term(false, true);
     const Eigen::Vector3d shift(1.0, 2.0, -3.0);
-    const Eigen::VectorXd moved[] = {rigidly_moved(d, d.rest(), Eigen::Matrix3d::Identity(), shift),
-                                     rigidly_moved(d, d.rest(), rotation(2.5, Eigen::Vector3d(0.3, -1, 0.7)), shift)};
+    const Eigen::VectorXd moved[] = {rigidly_moved(d, Eigen::Matrix3d::Identity(), shift),
+                                     rigidly_moved(d, rotation(2.5, Eigen::Vector3d(0.3, -1, 0.7)), shift)};
     for (const Eigen::VectorXd& x : moved) {
       const Eigen::VectorXd f = force_at(*corotated, d, x);
       std::printf("%s, rigid motion: energy %.2e J, largest force %.2e N\n", s.name.c_str(), corotated->energy(),
@@ -204,7 +127,7 @@ TEST(LinearFeTerm, RigidMotionsStoreNoEnergyAndMakeNoForce) {
     const Eigen::VectorXd f = force_at(*linear, d, moved[0]);
     EXPECT_LT(std::abs(linear->energy()), 1e-18) << s.name;  // translation: fine for the linear element too
     EXPECT_LT(f.cwiseAbs().maxCoeff(), 1e-10) << s.name;
-    const double turned = energy_of(*linear, d, rigidly_moved(d, d.rest(), rotation(0.5, Eigen::Vector3d(0, 1, 0)), shift));
+    const double turned = energy_at(*linear, d, rigidly_moved(d, rotation(0.5, Eigen::Vector3d(0, 1, 0)), shift));
     EXPECT_GT(turned, 1e-3) << s.name << ": the linear element should store energy under a rotation of 0.5 rad";
   }
 }
@@ -214,7 +137,7 @@ TEST(LinearFeTerm, RigidMotionsStoreNoEnergyAndMakeNoForce) {
 // times the area (ShellMaterial::membrane_stiffness() = E t/(1 − ν²)), exactly; no interior node
 // feels a force (the patch test), and the border x = +a/2 carries the resultant −σ_xx·b.
 TEST(LinearFeTerm, UniformStrainGivesThePlaneStressEnergyAndPassesThePatchTest) {
-  const ShellMaterial m = material(5000.0, 1e-4);
+  const ShellMaterial m = sheet_material(5000.0, 1e-4);
   const LinearFeDiscretization d(jittered_grid(), {}, m);
   const double area = 0.1 * 0.08, km = m.membrane_stiffness(), nu = m.poisson_ratio;
   struct Case {
@@ -282,21 +205,11 @@ TEST(LinearFeTerm, HingeEnergyOfACylinderConvergesToHalfBKappaSquaredTimesTheAre
     std::vector<double> errors;
     std::string row;
     for (int n : {8, 16, 32}) {
-      TriMesh mesh = c.lattice ? testing::make_lattice(n + 1) : make_grid(0.1, 0.1, n, n);
-      if (c.lattice) mesh.vertices *= 0.1 / n;  // side 0.1 m
-      const LinearFeDiscretization d(mesh, {}, material(5000.0, b));
-      double area = 0.0;
-      for (const Triangle& t : mesh.triangles)
-        area += 0.5 * (mesh.vertices.row(t[1]) - mesh.vertices.row(t[0])).cross(mesh.vertices.row(t[2]) - mesh.vertices.row(t[0])).norm();
-      const Eigen::Vector3d dir(std::cos(a), std::sin(a), 0.0), up(0, 0, 1);
-      Eigen::VectorXd x = d.rest();
-      for (int v = 0; v < d.num_nodes(); ++v) {
-        const Eigen::Vector3d p = d.rest().segment<3>(3 * v);
-        const double s = p.dot(dir);
-        x.segment<3>(3 * v) = p - s * dir + std::sin(kappa * s) / kappa * dir + (1.0 - std::cos(kappa * s)) / kappa * up;
-      }
+      const TriMesh mesh = c.lattice ? testing::make_lattice(n + 1, 0.1) : make_grid(0.1, 0.1, n, n);
+      const LinearFeDiscretization d(mesh, {}, sheet_material(5000.0, b));
+      const double area = mesh_area(mesh);
       std::unique_ptr<ForceTerm> term = d.elastic_term(true, false);
-      update_at(*term, d, x);
+      update_at(*term, d, bent_into_cylinder(d, a, kappa));
       errors.push_back(as_fe(term).bending_energy() / (factor * 0.5 * b * kappa * kappa * area) - 1.0);
       char cell[64];
       std::snprintf(cell, sizeof(cell), "  n = %2d: %+.5f", n, errors.back());
@@ -304,12 +217,7 @@ TEST(LinearFeTerm, HingeEnergyOfACylinderConvergesToHalfBKappaSquaredTimesTheAre
     }
     std::printf("  %-16s (factor %.3f)%s\n", c.name.c_str(), factor, row.c_str());
     EXPECT_LT(std::abs(errors[2]), 0.04) << c.name;
-    for (size_t k = 1; k < errors.size(); ++k)  // at least halved by each refinement, or already (nearly) exact
-      if (std::abs(errors[k - 1]) > 1e-3) {
-        EXPECT_LT(std::abs(errors[k]), 0.55 * std::abs(errors[k - 1])) << c.name << " at refinement " << k;
-      } else {
-        EXPECT_LT(std::abs(errors[k]), 1e-3) << c.name << " at refinement " << k;
-      }
+    testing::expect_halved_by_each_refinement(errors, c.name);
   }
 }
 
@@ -335,12 +243,9 @@ TEST(LinearFeTerm, HingeEnergyOfQuadraticDeflectionsMatchesTheDerivedDensities) 
       std::vector<double> errors;
       std::string row;
       for (int n : {8, 16, 32}) {
-        TriMesh mesh = lattice ? testing::make_lattice(n + 1) : make_grid(0.1, 0.1, n, n);
-        if (lattice) mesh.vertices *= 0.1 / n;
-        const LinearFeDiscretization d(mesh, {}, material(5000.0, b));
-        double area = 0.0;
-        for (const Triangle& t : mesh.triangles)
-          area += 0.5 * (mesh.vertices.row(t[1]) - mesh.vertices.row(t[0])).cross(mesh.vertices.row(t[2]) - mesh.vertices.row(t[0])).norm();
+        const TriMesh mesh = lattice ? testing::make_lattice(n + 1, 0.1) : make_grid(0.1, 0.1, n, n);
+        const LinearFeDiscretization d(mesh, {}, sheet_material(5000.0, b));
+        const double area = mesh_area(mesh);
         Eigen::VectorXd x = d.rest();
         for (int v = 0; v < d.num_nodes(); ++v) {
           const double px = x(3 * v), py = x(3 * v + 1);
@@ -403,7 +308,7 @@ TEST(LinearFeDihedral, AngleGradientAndHessian) {
 // the diagonal), in full symmetric storage with sorted rows; a bent state puts non-zero values
 // into every hinge's apex–apex block (the coupling only hinges make).
 TEST(LinearFeTerm, MatrixPatternHoldsTheTriangleAndHingeCouplings) {
-  const LinearFeDiscretization d(jittered_grid(), {}, material(5000.0, 1e-4));
+  const LinearFeDiscretization d(jittered_grid(), {}, sheet_material(5000.0, 1e-4));
   const Eigen::SparseMatrix<double>& p = d.matrix_pattern();
   const int n = d.num_nodes();
   ASSERT_EQ(p.rows(), 3 * n);
@@ -447,22 +352,7 @@ TEST(LinearFeTerm, MatrixPatternHoldsTheTriangleAndHingeCouplings) {
 // Kelvin–Voigt damping wraps the term: the same force and energy, the matrix (w_K + c w_D) K; mass
 // damping finds every diagonal entry in the pattern.
 TEST(LinearFeTerm, DampingWrappersWork) {
-  const LinearFeDiscretization d(jittered_grid(), {}, material(5000.0, 1e-4));
-  const Eigen::VectorXd x = testing::perturbed_rest(d, 2e-3, 9);
-  std::unique_ptr<ForceTerm> plain = d.elastic_term(true, true);
-  KelvinVoigtDamping damped(d.elastic_term(true, true), 0.01);
-  const Eigen::VectorXd f = force_at(*plain, d, x), fd = force_at(damped, d, x);
-  EXPECT_EQ(f, fd);
-  EXPECT_EQ(plain->energy(), damped.energy());
-  const double h = 2e-3;
-  const Eigen::MatrixXd k = matrix_at(*plain, d, x, {1.0, 0.0});
-  const Eigen::MatrixXd a = matrix_at(damped, d, x, {h * h, h});
-  EXPECT_LT((a - (h * h + 0.01 * h) * k).cwiseAbs().maxCoeff(), 1e-13 * a.cwiseAbs().maxCoeff());
-  const Eigen::VectorXd mass = d.lumped_mass(0.12);
-  MassDamping drag(mass, 2.0, d.matrix_pattern());
-  Eigen::SparseMatrix<double> m = d.matrix_pattern();
-  drag.add_matrix({h * h, h}, m);
-  for (int v = 0; v < d.num_nodes(); ++v) EXPECT_DOUBLE_EQ(m.coeff(3 * v + 1, 3 * v + 1), 2.0 * h * mass(v));
+  testing::expect_damping_wrappers_work(LinearFeDiscretization(jittered_grid(), {}, sheet_material(5000.0, 1e-4)));
 }
 
 }  // namespace

@@ -7,18 +7,17 @@
 // reference curvature, the matrix pattern and the damping wrappers.
 #include "sim/flat_fe/mass_spring.hpp"
 #include "sim/flat_fe/mass_spring_term.hpp"
-#include "sim/forces/damping.hpp"
 #include "sim/mesh/generators.hpp"
 #include "tests/support/fd_check.hpp"
+#include "tests/support/flat_terms.hpp"
+#include "tests/support/term_states.hpp"
 #include "tests/support/test_meshes.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
-#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -27,109 +26,28 @@
 namespace clothsim {
 namespace {
 
-using testing::check_force_against_energy;
+using testing::bent_into_cylinder;
 using testing::check_matrix_against_force;
 using testing::FdReport;
 using testing::force_at;
+using testing::jittered_grid;
 using testing::matrix_at;
+using testing::mesh_area;
+using testing::rigidly_moved;
+using testing::rotation;
+using testing::sheet_material;
+using testing::State;
+using testing::states;
 using testing::update_at;
 
 constexpr double kEps = 1e-6;  // finite-difference step [m]
 
-ShellMaterial material(double stretch_modulus, double bending_rigidity) {
-  ShellMaterial m;
-  m.stretch_modulus = stretch_modulus;
-  m.bending_rigidity = bending_rigidity;
-  m.poisson_ratio = 0.3;  // not used by the springs
-  m.areal_density = 0.12;
-  return m;
-}
-
-// A 0.1 m × 0.08 m grid (5 × 4 cells) whose interior vertices are moved in the plane by up to 15 %
-// of a cell (seeded): triangles of many shapes, still a valid mesh.
-TriMesh jittered_grid() {
-  TriMesh m = make_grid(0.1, 0.08, 5, 4);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-0.003, 0.003);
-  for (int v = 0; v < m.num_vertices(); ++v) {
-    const double x = m.vertices(v, 0), y = m.vertices(v, 1);
-    if (std::abs(std::abs(x) - 0.05) < 1e-9 || std::abs(std::abs(y) - 0.04) < 1e-9) continue;
-    m.vertices(v, 0) += u(rng);
-    m.vertices(v, 1) += u(rng);
-  }
-  return m;
-}
-
-// The equilateral lattice with n × n points and side `side` [m] in total along x (testing::make_lattice).
-TriMesh lattice(int n, double side) {
-  TriMesh m = testing::make_lattice(n);
-  m.vertices *= side / (n - 1);
-  return m;
-}
-
-double area_of(const TriMesh& m) {
-  double area = 0.0;
-  for (const Triangle& t : m.triangles)
-    area += 0.5 * (m.vertices.row(t[1]) - m.vertices.row(t[0])).cross(m.vertices.row(t[2]) - m.vertices.row(t[0])).norm();
-  return area;
-}
-
-Eigen::Matrix3d rotation(double angle, const Eigen::Vector3d& axis) {
-  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-}
-
-Eigen::VectorXd rigidly_moved(const Discretization& d, const Eigen::VectorXd& x0, const Eigen::Matrix3d& r,
-                              const Eigen::Vector3d& c) {
-  Eigen::VectorXd x = x0;
-  for (int v = 0; v < d.num_nodes(); ++v) x.segment<3>(3 * v) = r * x0.segment<3>(3 * v) + c;
-  return x;
-}
-
-struct State {
-  std::string name;
-  Eigen::VectorXd x;
-};
-
-// Rest, seeded random states (about 10 % of a cell), a strong in-plane compression, a fold by 150°
-// and a large rotation with strain.
-std::vector<State> states(const Discretization& d) {
-  std::vector<State> out;
-  out.push_back({"rest", d.rest()});
-  for (unsigned seed : {1u, 2u}) out.push_back({"random " + std::to_string(seed), testing::perturbed_rest(d, 2e-3, seed)});
-  Eigen::VectorXd compressed = testing::perturbed_rest(d, 2e-4, 7);
-  for (int v = 0; v < d.num_nodes(); ++v) compressed(3 * v) *= 0.7;
-  out.push_back({"compressed 30 %", compressed});
-  Eigen::VectorXd folded = testing::perturbed_rest(d, 2e-4, 11);
-  const Eigen::Matrix3d fold = rotation(150.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
-  for (int v = 0; v < d.num_nodes(); ++v)
-    if (folded(3 * v) > 0.001) folded.segment<3>(3 * v) = fold * folded.segment<3>(3 * v);
-  out.push_back({"folded 150 deg", folded});
-  Eigen::VectorXd turned = rigidly_moved(d, d.rest(), rotation(1.2, Eigen::Vector3d(1, 2, -0.5)), Eigen::Vector3d(0.01, -0.02, 0.03));
-  turned += testing::perturbed_rest(d, 1e-3, 13) - d.rest();
-  out.push_back({"large rotation", turned});
-  return out;
-}
-
-struct Structure {
-  std::string name;
-  std::unique_ptr<MassSpringDiscretization> d;
-};
+using Structure = testing::Structure<MassSpringDiscretization>;
 
 // The jittered grid (flat at rest) and a short sleeve (curved at rest), each in three materials so
 // that each kind of spring is checked where it dominates the force. The reference curvature is the
 // material's (its inverse bending length).
-std::vector<Structure> structures() {
-  std::vector<Structure> out;
-  const std::pair<std::string, ShellMaterial> materials[] = {{"cloth", material(5000.0, 1e-4)},
-                                                             {"bending only", material(1e-6, 1e-4)},
-                                                             {"stretch only", material(5000.0, 1e-12)}};
-  for (const auto& [name, m] : materials) {
-    out.push_back({"grid, " + name, std::make_unique<MassSpringDiscretization>(jittered_grid(), std::vector<BoundaryCondition>{}, m)});
-    out.push_back({"sleeve, " + name, std::make_unique<MassSpringDiscretization>(make_cylinder(0.03, 0.06, 8, 4),
-                                                                                   std::vector<BoundaryCondition>{}, m)});
-  }
-  return out;
-}
+std::vector<Structure> structures() { return testing::grid_and_sleeve<MassSpringDiscretization>("stretch only"); }
 
 MassSpringElastic& as_springs(std::unique_ptr<ForceTerm>& term) { return dynamic_cast<MassSpringElastic&>(*term); }
 
@@ -166,15 +84,8 @@ double plane_stress_density(double stretch_modulus, double nu, double exx, doubl
 TEST(MassSpringTerm, ForceIsTheGradientOfTheEnergy) {
   double worst = 0.0;
   for (const Structure& s : structures()) {
-    const std::vector<State> all = states(*s.d);
     std::unique_ptr<ForceTerm> term = s.d->elastic_term(true, true);
-    const double floor = force_at(*term, *s.d, all[1].x).cwiseAbs().maxCoeff();
-    for (const State& state : all) {
-      FdReport r = check_force_against_energy(*term, *s.d, state.x, kEps);
-      r.floor = floor;
-      worst = std::max(worst, r.relative());
-      EXPECT_LT(r.relative(), 1e-6) << s.name << ", " << state.name << ": " << r.describe();
-    }
+    worst = std::max(worst, testing::expect_force_is_the_gradient(*term, *s.d, states(*s.d), kEps, s.name));
   }
   std::printf("mass_spring force vs energy: worst relative error %.2e over %zu structures x 6 states\n", worst,
               structures().size());
@@ -203,7 +114,7 @@ TEST(MassSpringTerm, SolverMatrixIsSymmetricPositiveSemidefiniteAndExactWhereNoS
     if (s.name.find("cloth") == std::string::npos) continue;
     std::vector<State> all = states(*s.d);
     all.push_back({"expanded 10 %, turned",
-                   rigidly_moved(*s.d, s.d->rest(), 1.1 * rotation(0.7, Eigen::Vector3d(1, -1, 2)), Eigen::Vector3d(0.1, 0, 0))});
+                   rigidly_moved(*s.d, 1.1 * rotation(0.7, Eigen::Vector3d(1, -1, 2)), Eigen::Vector3d(0.1, 0, 0))});
     for (bool stiffening : {true, false})
       for (const State& state : all) {
         std::unique_ptr<ForceTerm> term = s.d->elastic_term(true, stiffening);
@@ -241,8 +152,8 @@ TEST(MassSpringTerm, RigidMotionsStoreNoEnergyAndMakeNoForce) {
     const Discretization& d = *s.d;
     std::unique_ptr<ForceTerm> corotated = d.elastic_term(true, true), linear = d.elastic_term(false, true);
     const Eigen::Vector3d shift(1.0, 2.0, -3.0);
-    const Eigen::VectorXd moved[] = {rigidly_moved(d, d.rest(), Eigen::Matrix3d::Identity(), shift),
-                                     rigidly_moved(d, d.rest(), rotation(2.5, Eigen::Vector3d(0.3, -1, 0.7)), shift)};
+    const Eigen::VectorXd moved[] = {rigidly_moved(d, Eigen::Matrix3d::Identity(), shift),
+                                     rigidly_moved(d, rotation(2.5, Eigen::Vector3d(0.3, -1, 0.7)), shift)};
     for (const Eigen::VectorXd& x : moved) {
       const Eigen::VectorXd f = force_at(*corotated, d, x), g = force_at(*linear, d, x);
       std::printf("%s, rigid motion: energy %.2e J, largest force %.2e N\n", s.name.c_str(), corotated->energy(),
@@ -264,9 +175,9 @@ TEST(MassSpringTerm, RigidMotionsStoreNoEnergyAndMakeNoForce) {
 // geometric nonlinearity). A material with ν = 1/3 is therefore matched exactly, the material's own
 // ν = 0.3 is not (printed).
 TEST(MassSpringTerm, StretchSpringsOnTheEquilateralLatticeArePlaneStressWithPoissonRatioOneThird) {
-  const ShellMaterial m = material(5000.0, 1e-5);
-  const MassSpringDiscretization d(lattice(9, 0.1), {}, m);
-  const double area = area_of(d.mesh());
+  const ShellMaterial m = sheet_material(5000.0, 1e-5);
+  const MassSpringDiscretization d(testing::make_lattice(9, 0.1), {}, m);
+  const double area = mesh_area(d.mesh());
   struct Case {
     const char* name;
     double exx, eyy, gamma;
@@ -297,7 +208,7 @@ TEST(MassSpringTerm, StretchSpringsOnTheEquilateralLatticeArePlaneStressWithPois
 // anisotropic (shears of opposite sign differ; stretch couples to shear). Printed against the
 // isotropic law with ν = 1/3.
 TEST(MassSpringTerm, StretchSpringsOnTheGridGiveTheDerivedAnisotropicLaw) {
-  const ShellMaterial m = material(5000.0, 1e-5);
+  const ShellMaterial m = sheet_material(5000.0, 1e-5);
   const MassSpringDiscretization d(make_grid(0.1, 0.08, 10, 8), {}, m);
   const double area = 0.1 * 0.08;
   struct Case {
@@ -337,18 +248,18 @@ TEST(MassSpringTerm, StretchSpringsOnTheGridGiveTheDerivedAnisotropicLaw) {
 // form as the edge springs); the interior edges only carry them, so the measured addition
 // approaches that as the lattice is refined (the border's missing springs, O(h)).
 TEST(MassSpringTerm, BendingSpringsAddInPlaneStiffnessGrowingAsTheMeshIsRefined) {
-  const ShellMaterial m = material(5000.0, 1e-5);
+  const ShellMaterial m = sheet_material(5000.0, 1e-5);
   const double kappa = MassSpringDiscretization::bending_length_curvature(m);
   std::printf("bending springs' in-plane stiffness (cloth: E t = %.0f N/m, B = %.0e N m, kappa_ref = %.2f 1/m):\n",
               m.stretch_modulus, m.bending_rigidity, kappa);
   std::vector<double> errors;
   for (int n : {8, 16, 32}) {
     const double h = 0.1 / n;
-    const MassSpringDiscretization d(lattice(n + 1, 0.1), {}, m);
+    const MassSpringDiscretization d(testing::make_lattice(n + 1, 0.1), {}, m);
     const double added = 73728.0 / 945.0 * m.bending_rigidity / (kappa * kappa * h * h * h * h);  // [N/m]
     const Eigen::VectorXd u = uniform_strain(d, 1e-4, -0.3e-4, 0.5e-4);
     const double measured = linearised_energy(d.bending_springs(), d.rest(), u);
-    const double expected = plane_stress_density(added, 1.0 / 3.0, 1e-4, -0.3e-4, 0.5e-4) * area_of(d.mesh());
+    const double expected = plane_stress_density(added, 1.0 / 3.0, 1e-4, -0.3e-4, 0.5e-4) * mesh_area(d.mesh());
     errors.push_back(measured / expected - 1.0);
     std::printf("  h = %.5f m: adds %.4e N/m = %.2e E t; measured / derived - 1 = %+.4f\n", h, added,
                 added / m.stretch_modulus, errors.back());
@@ -362,7 +273,7 @@ TEST(MassSpringTerm, BendingSpringsAddInPlaneStiffnessGrowingAsTheMeshIsRefined)
 // The reference curvature: the inverse bending length (ρ_A g / B)^(1/3) unless given; a material
 // without mass cannot set it.
 TEST(MassSpringTerm, ReferenceCurvatureIsTheInverseBendingLength) {
-  ShellMaterial m = material(5000.0, 1e-5);
+  ShellMaterial m = sheet_material(5000.0, 1e-5);
   m.areal_density = 0.1;
   const double expected = std::cbrt(0.1 * 9.80665 / 1e-5);
   const MassSpringDiscretization d(make_grid(0.1, 0.1, 2, 2), {}, m);
@@ -409,18 +320,11 @@ TEST(MassSpringTerm, BendingSpringEnergyOfACylinderAtTheReferenceCurvature) {
     std::string row;
     double stretch_ratio = 0.0;
     for (int n : {8, 16, 32}) {
-      const TriMesh mesh = c.lattice ? lattice(n + 1, 0.1) : make_grid(0.1, 0.1, n, n);
-      const MassSpringDiscretization d(mesh, {}, material(5000.0, b), kappa);
-      const Eigen::Vector3d dir(std::cos(a), std::sin(a), 0.0), up(0, 0, 1);
-      Eigen::VectorXd x = d.rest();
-      for (int v = 0; v < d.num_nodes(); ++v) {
-        const Eigen::Vector3d p = d.rest().segment<3>(3 * v);
-        const double s = p.dot(dir);
-        x.segment<3>(3 * v) = p - s * dir + std::sin(kappa * s) / kappa * dir + (1.0 - std::cos(kappa * s)) / kappa * up;
-      }
+      const TriMesh mesh = c.lattice ? testing::make_lattice(n + 1, 0.1) : make_grid(0.1, 0.1, n, n);
+      const MassSpringDiscretization d(mesh, {}, sheet_material(5000.0, b), kappa);
       std::unique_ptr<ForceTerm> term = d.elastic_term(true, true);
-      update_at(*term, d, x);
-      const double reference = 0.5 * b * kappa * kappa * area_of(mesh);
+      update_at(*term, d, bent_into_cylinder(d, a, kappa));
+      const double reference = 0.5 * b * kappa * kappa * mesh_area(mesh);
       errors.push_back(as_springs(term).bending_energy() / (factor * reference) - 1.0);
       stretch_ratio = as_springs(term).stretch_energy() / reference;
       char cell[64];
@@ -430,12 +334,7 @@ TEST(MassSpringTerm, BendingSpringEnergyOfACylinderAtTheReferenceCurvature) {
     std::printf("  %-16s (factor %.4f)%s; stretch springs at n = 32: %.3f x B kappa^2/2 area\n", c.name.c_str(), factor,
                 row.c_str(), stretch_ratio);
     EXPECT_LT(std::abs(errors[2]), 0.04) << c.name;
-    for (size_t k = 1; k < errors.size(); ++k)  // at least halved by each refinement, or already (nearly) exact
-      if (std::abs(errors[k - 1]) > 1e-3) {
-        EXPECT_LT(std::abs(errors[k]), 0.55 * std::abs(errors[k - 1])) << c.name << " at refinement " << k;
-      } else {
-        EXPECT_LT(std::abs(errors[k]), 1e-3) << c.name << " at refinement " << k;
-      }
+    testing::expect_halved_by_each_refinement(errors, c.name);
   }
 }
 
@@ -444,9 +343,9 @@ TEST(MassSpringTerm, BendingSpringEnergyOfACylinderAtTheReferenceCurvature) {
 // neighbouring curvatures of the lattice bent across x.
 TEST(MassSpringTerm, BendingSpringEnergyIsQuarticInTheCurvature) {
   const double b = 1e-4, kappa_ref = 5.0;
-  const TriMesh mesh = lattice(33, 0.1);
-  const MassSpringDiscretization d(mesh, {}, material(5000.0, b), kappa_ref);
-  const double area = area_of(mesh), factor = 27.0 / 35.0;  // φ = 0
+  const TriMesh mesh = testing::make_lattice(33, 0.1);
+  const MassSpringDiscretization d(mesh, {}, sheet_material(5000.0, b), kappa_ref);
+  const double area = mesh_area(mesh), factor = 27.0 / 35.0;  // φ = 0
   std::unique_ptr<ForceTerm> term = d.elastic_term(true, true);
   std::vector<double> kappas = {0.25 * kappa_ref, 0.5 * kappa_ref, kappa_ref, 2 * kappa_ref, 4 * kappa_ref}, energies;
   for (double kappa : kappas) {
@@ -480,7 +379,7 @@ TEST(MassSpringTerm, BendingSpringEnergyIsQuarticInTheCurvature) {
 // at its reference curvature on centimetre meshes (printed) — the flat triangles' membrane locking,
 // which the bending springs add to.
 TEST(MassSpringTerm, StretchSpringsResistIsometricBendingAsTheDerivedChordLaw) {
-  const ShellMaterial m = material(5000.0, 1e-5);
+  const ShellMaterial m = sheet_material(5000.0, 1e-5);
   const double kappa = MassSpringDiscretization::bending_length_curvature(m);
   std::printf("isometric cylinder of the lattice at kappa_ref = %.2f 1/m (E t = %.0f N/m, B = %.0e N m):\n", kappa,
               m.stretch_modulus, m.bending_rigidity);
@@ -488,18 +387,11 @@ TEST(MassSpringTerm, StretchSpringsResistIsometricBendingAsTheDerivedChordLaw) {
     const double a = angle_deg * M_PI / 180.0;
     for (int n : {8, 16, 32}) {
       const double h = 0.1 / n;
-      const TriMesh mesh = lattice(n + 1, 0.1);
+      const TriMesh mesh = testing::make_lattice(n + 1, 0.1);
       const MassSpringDiscretization d(mesh, {}, m);
-      const Eigen::Vector3d dir(std::cos(a), std::sin(a), 0.0), up(0, 0, 1);
-      Eigen::VectorXd x = d.rest();
-      for (int v = 0; v < d.num_nodes(); ++v) {
-        const Eigen::Vector3d p = d.rest().segment<3>(3 * v);
-        const double s = p.dot(dir);
-        x.segment<3>(3 * v) = p - s * dir + std::sin(kappa * s) / kappa * dir + (1.0 - std::cos(kappa * s)) / kappa * up;
-      }
       std::unique_ptr<ForceTerm> term = d.elastic_term(true, true);
-      update_at(*term, d, x);
-      const double area = area_of(mesh);
+      update_at(*term, d, bent_into_cylinder(d, a, kappa));
+      const double area = mesh_area(mesh);
       const double derived =
           m.stretch_modulus * std::pow(kappa * kappa * h * h, 2) / 1152.0 * 3.0 / 128.0 * (35.0 + 8.0 * std::cos(6 * a)) * area;
       const double bending = 0.5 * m.bending_rigidity * kappa * kappa * area;
@@ -517,7 +409,7 @@ TEST(MassSpringTerm, StretchSpringsResistIsometricBendingAsTheDerivedChordLaw) {
 // springs cover the triangles' pairs, the bending springs the hinges' apex pairs. One stretch
 // spring per edge, one bending spring per hinge, each naming its group's slots correctly.
 TEST(MassSpringTerm, MatrixPatternCoversEverySpring) {
-  const MassSpringDiscretization d(jittered_grid(), {}, material(5000.0, 1e-4));
+  const MassSpringDiscretization d(jittered_grid(), {}, sheet_material(5000.0, 1e-4));
   const Eigen::SparseMatrix<double>& p = d.matrix_pattern();
   std::set<std::pair<int, int>> in_pattern;
   for (Eigen::Index col = 0; col < p.cols(); ++col)
@@ -553,28 +445,15 @@ TEST(MassSpringTerm, MatrixPatternCoversEverySpring) {
 // Kelvin–Voigt damping wraps the term: the same force and energy, the matrix (w_K + c w_D) K; mass
 // damping finds every diagonal entry in the pattern.
 TEST(MassSpringTerm, DampingWrappersWork) {
-  const MassSpringDiscretization d(jittered_grid(), {}, material(5000.0, 1e-4));
-  const Eigen::VectorXd x = testing::perturbed_rest(d, 2e-3, 9);
-  std::unique_ptr<ForceTerm> plain = d.elastic_term(true, true);
-  KelvinVoigtDamping damped(d.elastic_term(true, true), 0.01);
-  const Eigen::VectorXd f = force_at(*plain, d, x), fd = force_at(damped, d, x);
-  EXPECT_EQ(f, fd);
-  EXPECT_EQ(plain->energy(), damped.energy());
-  const double h = 2e-3;
-  const Eigen::MatrixXd k = matrix_at(*plain, d, x, {1.0, 0.0});
-  const Eigen::MatrixXd a = matrix_at(damped, d, x, {h * h, h});
-  EXPECT_GT(k.cwiseAbs().maxCoeff(), 0.0);
-  EXPECT_LT((a - (h * h + 0.01 * h) * k).cwiseAbs().maxCoeff(), 1e-13 * a.cwiseAbs().maxCoeff());
-  const Eigen::VectorXd mass = d.lumped_mass(0.12);
-  MassDamping drag(mass, 2.0, d.matrix_pattern());
-  Eigen::SparseMatrix<double> m = d.matrix_pattern();
-  drag.add_matrix({h * h, h}, m);
-  for (int v = 0; v < d.num_nodes(); ++v) EXPECT_DOUBLE_EQ(m.coeff(3 * v + 1, 3 * v + 1), 2.0 * h * mass(v));
+  const MassSpringDiscretization d(jittered_grid(), {}, sheet_material(5000.0, 1e-4));
+  testing::expect_damping_wrappers_work(d);
+  std::unique_ptr<ForceTerm> term = d.elastic_term(true, true);
+  EXPECT_GT(matrix_at(*term, d, testing::perturbed_rest(d, 2e-3, 9), {1.0, 0.0}).cwiseAbs().maxCoeff(), 0.0);
 }
 
 // Two nodes of a spring at the same place: the direction is undefined and the update says which.
 TEST(MassSpringTerm, CoincidentNodesAreReported) {
-  const MassSpringDiscretization d(make_grid(0.1, 0.1, 2, 2), {}, material(5000.0, 1e-4));
+  const MassSpringDiscretization d(make_grid(0.1, 0.1, 2, 2), {}, sheet_material(5000.0, 1e-4));
   std::unique_ptr<ForceTerm> term = d.elastic_term(true, true);
   Eigen::VectorXd x = d.rest();
   const Spring& s = d.stretch_springs().front();

@@ -13,6 +13,7 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/scene/scene.hpp"
 #include "tests/support/fd_check.hpp"
+#include "tests/support/term_states.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -30,6 +31,9 @@ using testing::check_matrix_against_force;
 using testing::FdReport;
 using testing::force_at;
 using testing::matrix_at;
+using testing::rigidly_moved;
+using testing::rotation;
+using testing::State;
 using testing::update_at;
 
 constexpr double kSize = 0.1;   // plate side [m]
@@ -75,43 +79,10 @@ std::vector<Structure> structures() {
   return out;
 }
 
-Eigen::Matrix3d rotation(double angle, const Eigen::Vector3d& axis) {
-  return Eigen::AngleAxisd(angle, axis.normalized()).toRotationMatrix();
-}
-
-// Node positions x = R X + c (3·#nodes).
-Eigen::VectorXd rigidly_moved(const Discretization& d, const Eigen::Matrix3d& r, const Eigen::Vector3d& c) {
-  Eigen::VectorXd x = d.rest();
-  for (int v = 0; v < d.num_nodes(); ++v) x.segment<3>(3 * v) = r * x.segment<3>(3 * v) + c;
-  return x;
-}
-
-// The states of the checks, each with the rigid part the discretisation's constraints allow
-// (fixed components are moved too: the terms do not care which components are prescribed).
-struct State {
-  std::string name;
-  Eigen::VectorXd x;
-};
-
+// The states of the checks (tests/support/term_states.hpp): three random ones, and the part with
+// x > 0 turned 170° about the y axis (a crease along x = 0).
 std::vector<State> states(const Discretization& d) {
-  std::vector<State> out;
-  out.push_back({"rest", d.rest()});
-  for (unsigned seed : {1u, 2u, 3u}) out.push_back({"random " + std::to_string(seed), testing::perturbed_rest(d, 2e-3, seed)});
-  // Strong compression: 30 % shorter along x, with a little noise to leave the symmetric state.
-  Eigen::VectorXd compressed = testing::perturbed_rest(d, 2e-4, 7);
-  for (int v = 0; v < d.num_nodes(); ++v) compressed(3 * v) *= 0.7;
-  out.push_back({"compressed 30 %", compressed});
-  // Near-folded: the part with x > 0 turned 170° about the y axis (a crease along x = 0).
-  Eigen::VectorXd folded = testing::perturbed_rest(d, 2e-4, 11);
-  const Eigen::Matrix3d fold = rotation(170.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
-  for (int v = 0; v < d.num_nodes(); ++v)
-    if (folded(3 * v) > 0) folded.segment<3>(3 * v) = fold * folded.segment<3>(3 * v);
-  out.push_back({"near-folded", folded});
-  // Large rotation: 1.2 rad about a skew axis, plus a small strain.
-  Eigen::VectorXd turned = rigidly_moved(d, rotation(1.2, Eigen::Vector3d(1, 2, -0.5)), Eigen::Vector3d(0.01, -0.02, 0.03));
-  turned += testing::perturbed_rest(d, 1e-3, 13) - d.rest();
-  out.push_back({"large rotation", turned});
-  return out;
+  return testing::states(d, {.random_states = 3, .fold_degrees = 170.0, .fold_from = 0.0, .fold_name = "near-folded"});
 }
 
 // The corotated shell: with the rotations frozen at the state, the force is exactly −∂E/∂x and
