@@ -2,6 +2,7 @@
 
 #include "sim/flat_fe/flat_fe_term.hpp"
 #include "sim/mesh/topology.hpp"
+#include "sim/shell/shell_model.hpp"
 #include "sim/subdivision/loop.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -105,33 +106,11 @@ std::vector<std::string> FlatDiscretization::unrestrained_rigid_motions() const 
       gram += r * r.transpose();
     }
   }
-  std::vector<std::string> out;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(gram);
-  const double scale = std::max(1.0, eig.eigenvalues().maxCoeff());
-  const char* axes = "xyz";
-  for (int k = 0; k < 6; ++k) {
-    if (eig.eigenvalues()(k) > 1e-9 * scale) continue;
-    const Eigen::Matrix<double, 6, 1> mode = eig.eigenvectors().col(k);
-    std::ostringstream s;
-    bool first = true;
-    for (int i = 0; i < 6; ++i) {
-      if (std::abs(mode(i)) < 1e-6) continue;
-      s << (first ? "" : " + ") << (i < 3 ? "translation along " : "rotation about ") << axes[i % 3];
-      first = false;
-    }
-    out.push_back(s.str());
-  }
-  return out;
+  return free_rigid_motions(gram);
 }
 
 Eigen::VectorXd FlatDiscretization::lumped_mass(double areal_density) const {
-  Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh_.num_vertices());
-  for (const Triangle& t : mesh_.triangles) {
-    const Eigen::Vector3d x0 = mesh_.vertices.row(t[0]), x1 = mesh_.vertices.row(t[1]), x2 = mesh_.vertices.row(t[2]);
-    const double area = 0.5 * (x1 - x0).cross(x2 - x0).norm();
-    for (int v : t) mass(v) += areal_density * area / 3.0;
-  }
-  return mass;
+  return lumped_vertex_mass(mesh_, areal_density);
 }
 
 Eigen::VectorXd FlatDiscretization::traction_load(

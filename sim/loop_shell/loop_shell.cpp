@@ -52,13 +52,7 @@ void LoopShellDiscretization::make_consistent(Eigen::VectorXd& u) const {
 }
 
 Eigen::VectorXd LoopShellDiscretization::lumped_mass(double areal_density) const {
-  Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh_.num_vertices());
-  for (const Triangle& t : mesh_.triangles) {
-    const Eigen::Vector3d x0 = mesh_.vertices.row(t[0]), x1 = mesh_.vertices.row(t[1]), x2 = mesh_.vertices.row(t[2]);
-    const double area = 0.5 * (x1 - x0).cross(x2 - x0).norm();
-    for (int v : t) mass(v) += areal_density * area / 3.0;
-  }
-  return mass;
+  return lumped_vertex_mass(mesh_, areal_density);
 }
 
 Eigen::VectorXd LoopShellDiscretization::traction_load(

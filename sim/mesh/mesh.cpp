@@ -25,4 +25,14 @@ void check_triangles(const TriMesh& mesh) {
   }
 }
 
+Eigen::VectorXd lumped_vertex_mass(const TriMesh& mesh, double areal_density) {
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(mesh.num_vertices());
+  for (const Triangle& t : mesh.triangles) {
+    const Eigen::Vector3d x0 = mesh.vertices.row(t[0]), x1 = mesh.vertices.row(t[1]), x2 = mesh.vertices.row(t[2]);
+    const double area = 0.5 * (x1 - x0).cross(x2 - x0).norm();
+    for (int v : t) mass(v) += areal_density * area / 3.0;
+  }
+  return mass;
+}
+
 }  // namespace clothsim

@@ -34,4 +34,8 @@ class MeshError : public std::runtime_error {
 // (area below 1e-12 of the squared bounding-box diagonal), naming the triangle.
 void check_triangles(const TriMesh& mesh);
 
+// Lumped mass per vertex [kg]: a third of each incident triangle's rest area [m²] times
+// `areal_density` [kg/m²].
+Eigen::VectorXd lumped_vertex_mass(const TriMesh& mesh, double areal_density);
+
 }  // namespace clothsim

@@ -287,6 +287,26 @@ Eigen::MatrixX3d ShellModel::limit_points(const Eigen::MatrixX3d& x) const {
   return out;
 }
 
+std::vector<std::string> free_rigid_motions(const Eigen::Matrix<double, 6, 6>& gram) {
+  std::vector<std::string> out;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(gram);
+  const double scale = std::max(1.0, eig.eigenvalues().maxCoeff());
+  const char* axes = "xyz";
+  for (int k = 0; k < 6; ++k) {
+    if (eig.eigenvalues()(k) > 1e-9 * scale) continue;
+    const Eigen::Matrix<double, 6, 1> mode = eig.eigenvectors().col(k);
+    std::ostringstream s;
+    bool first = true;
+    for (int i = 0; i < 6; ++i) {
+      if (std::abs(mode(i)) < 1e-6) continue;
+      s << (first ? "" : " + ") << (i < 3 ? "translation along " : "rotation about ") << axes[i % 3];
+      first = false;
+    }
+    out.push_back(s.str());
+  }
+  return out;
+}
+
 std::vector<std::string> ShellModel::unrestrained_rigid_motions() const {
   // A rigid motion r = t + ω × (X − centroid)/size moves the model without strain exactly when
   // every displacement the DOF map derives (fixed components: zero; tied components and ghosts:
@@ -315,23 +335,7 @@ std::vector<std::string> ShellModel::unrestrained_rigid_motions() const {
           if (dofs_.is_free(dof / 3, dof % 3)) residual -= w * rigid(dof / 3, dof % 3);
       gram += residual * residual.transpose();
     }
-  std::vector<std::string> out;
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> eig(gram);
-  const double scale = std::max(1.0, eig.eigenvalues().maxCoeff());
-  const char* axes = "xyz";
-  for (int k = 0; k < 6; ++k) {
-    if (eig.eigenvalues()(k) > 1e-9 * scale) continue;
-    const Eigen::Matrix<double, 6, 1> mode = eig.eigenvectors().col(k);
-    std::ostringstream s;
-    bool first = true;
-    for (int i = 0; i < 6; ++i) {
-      if (std::abs(mode(i)) < 1e-6) continue;
-      s << (first ? "" : " + ") << (i < 3 ? "translation along " : "rotation about ") << axes[i % 3];
-      first = false;
-    }
-    out.push_back(s.str());
-  }
-  return out;
+  return free_rigid_motions(gram);
 }
 
 }  // namespace clothsim

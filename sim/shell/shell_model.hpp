@@ -37,6 +37,13 @@ struct ShellElement {
                                      // are unit rows)
 };
 
+// The rigid motions left free, in words ("translation along y", "rotation about x + rotation
+// about z"), from the Gram matrix of the six basis motions (translations along x, y, z, then
+// rotations about x, y, z, in units of the structure's size) sampled where the structure is held:
+// its null space (eigenvalues below 1e-9 of the largest, or of 1) is what the constraints leave
+// free. Used by every discretisation's unrestrained_rigid_motions().
+std::vector<std::string> free_rigid_motions(const Eigen::Matrix<double, 6, 6>& gram);
+
 class ShellModel {
  public:
   ShellModel(const TriMesh& mesh, const ShellMaterial& material, const std::vector<BoundaryCondition>& conditions,
