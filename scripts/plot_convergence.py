@@ -4,7 +4,11 @@
 Usage: plot_convergence.py RESULTS.csv OUTPUT.png
 
 Reads the results.csv written by `clothsim study convergence` (columns documented in
-docs/convergence.md) and draws one panel for the static plates and one per dynamic case. Colour
+docs/convergence.md) and draws one panel for the static plates and one per dynamic case, then for
+each dynamic case that has the post-buckling columns two more: the relative elastic-energy error at
+the end of the run against wall time (log-log; mesh series solid, time-step series dashed), and the
+fold counts at the end of the run against control vertices (mesh series; circumferential median
+solid, axial median dashed, the reference run's counts as grey horizontal lines). Colour
 = method (the same in every panel, so later baseline methods are new colours), marker and line
 style = plate case (plates panel) or series and error window (dynamic panels: solid = mesh
 refinement at a fixed time step, dashed = time-step refinement on the reference mesh, both with
@@ -90,6 +94,101 @@ def draw_reference_precision(ax, rows):
                     xycoords=("axes fraction", "data"), ha="right", va="bottom", fontsize=6.5, color="0.45")
 
 
+def number(row, column):
+    """The row's value in `column` as a float, or None when absent, empty or not finite."""
+    try:
+        value = float(row.get(column) or "")
+    except ValueError:
+        return None
+    return value if math.isfinite(value) else None
+
+
+def end_state_rows(rows, case):
+    """One row per run of a dynamic case (the end-of-run columns repeat in every window's rows):
+    the rows of the case's last window, in file order."""
+    windows = [r.get("window", "") for r in rows if r["case"] == case]
+    last = windows[-1] if windows else ""
+    return [r for r in rows if r["case"] == case and r.get("window", "") == last]
+
+
+def has_end_state(rows, case):
+    return any(number(r, "elastic_energy") is not None for r in end_state_rows(rows, case))
+
+
+def draw_energy_panel(ax, rows, case, colour):
+    """Relative elastic-energy error at the end of the run against wall time."""
+    curves = {}
+    for r in end_state_rows(rows, case):
+        error, seconds = number(r, "energy_error"), number(r, "wall_seconds")
+        if r["series"] == "reference" or error is None or error <= 0 or seconds is None or seconds <= 0:
+            continue
+        curves.setdefault((r["method"], r["series"]), []).append((seconds, error, short_setting(r)))
+    for (method, series), points in curves.items():
+        marker, style = SERIES_STYLES.get(series, ("v", "-"))
+        ax.plot([p[0] for p in points], [p[1] for p in points], linestyle=style, marker=marker,
+                color=colour[method], markersize=5)
+        if series == "mesh":
+            for xi, yi, label in points:
+                ax.annotate(label, (xi, yi), textcoords="offset points", xytext=(4, 4), fontsize=6.5, color="0.35")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time per run [s]")
+    ax.set_ylabel("|E - E_ref| / |E_ref|  [-]")
+    ends = [number(r, "steps") * number(r, "dt") for r in end_state_rows(rows, case)
+            if number(r, "steps") is not None and number(r, "dt") is not None]
+    end = f" (t = {ends[0]:g} s)" if ends else ""
+    ax.set_title(f"{case}: elastic energy at the end of the run{end} vs. reference", fontsize=10)
+    ax.grid(True, which="major", alpha=0.4)
+    ax.grid(True, which="minor", alpha=0.12)
+    handles = [plt.Line2D([], [], color="0.3", linestyle=SERIES_STYLES[s][1], marker=SERIES_STYLES[s][0],
+                          label=SERIES_LABELS[s]) for s in ("mesh", "dt")]
+    ax.legend(handles=handles, fontsize=7, loc="best")
+    if not curves:
+        ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
+
+
+def draw_fold_panel(ax, rows, case, colour):
+    """Fold counts at the end of the run against control vertices (mesh series), with the
+    reference run's counts as horizontal lines."""
+    styles = {"folds_circumferential": ("o", "-", "circumferential (median over heights)"),
+              "folds_axial": ("^", "--", "axial (median over meridians)")}
+    drawn = False
+    for r in end_state_rows(rows, case):
+        if r["series"] == "reference":
+            for column, (_, style, _) in styles.items():
+                value = number(r, column)
+                if value is not None:
+                    ax.axhline(value, color="0.55", linestyle=style, linewidth=1.2, zorder=0)
+                    ax.annotate(f"reference {column.split('_')[1]}: {value:g}", (0.99, value),
+                                xycoords=("axes fraction", "data"), ha="right", va="bottom", fontsize=6.5, color="0.4")
+            break
+    curves = {}
+    for r in end_state_rows(rows, case):
+        if r["series"] != "mesh":
+            continue
+        vertices = number(r, "vertices")
+        for column in styles:
+            value = number(r, column)
+            if vertices is not None and vertices > 0 and value is not None:
+                curves.setdefault((r["method"], column), []).append((vertices, value))
+    for (method, column), points in curves.items():
+        marker, style, _ = styles[column]
+        ax.plot([p[0] for p in points], [p[1] for p in points], linestyle=style, marker=marker, color=colour[method],
+                markersize=5)
+        drawn = True
+    ax.set_xscale("log")
+    ax.set_xlabel("control vertices (mesh series)")
+    ax.set_ylabel("folds at the end of the run")
+    ax.set_title(f"{case}: fold count of the drawn surface (count_sleeve_folds)", fontsize=10)
+    ax.grid(True, alpha=0.4)
+    handles = [plt.Line2D([], [], color="0.3", linestyle=style, marker=marker, label=label)
+               for marker, style, label in styles.values()]
+    handles.append(plt.Line2D([], [], color="0.55", label="reference run"))
+    ax.legend(handles=handles, fontsize=7, loc="best")
+    if not drawn:
+        ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
+
+
 def main(argv):
     if len(argv) != 3:
         sys.stderr.write("usage: plot_convergence.py RESULTS.csv OUTPUT.png\n")
@@ -104,11 +203,18 @@ def main(argv):
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     colour = {m: colours[i % len(colours)] for i, m in enumerate(methods)}
 
-    columns = 2 if len(panels) > 1 else 1
-    grid_rows = max(1, math.ceil(len(panels) / columns))
+    # The post-buckling panels: energy and folds for every dynamic case that has them, in pairs.
+    extra = [(kind, case) for case in panels if case != PLATES and has_end_state(rows, case)
+             for kind in ("energy", "folds")]
+    columns = 2 if len(panels) + len(extra) > 1 else 1
+    first_extra = math.ceil(len(panels) / columns) * columns  # the pairs start on a new row
+    grid_rows = max(1, math.ceil((first_extra + len(extra)) / columns)) if extra else max(1, math.ceil(len(panels) / columns))
     fig, axes = plt.subplots(grid_rows, columns, figsize=(16, 5.4 * grid_rows + 0.8), dpi=100, squeeze=False)
     for ax in axes.flat[len(panels):]:
         ax.set_visible(False)
+    for ax, (kind, case) in zip(axes.flat[first_extra:], extra):
+        ax.set_visible(True)
+        (draw_energy_panel if kind == "energy" else draw_fold_panel)(ax, rows, case, colour)
 
     shared_legend = {}  # dynamic panels: label -> handle (same styles in every panel)
     for ax, panel in zip(axes.flat, panels):

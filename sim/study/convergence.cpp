@@ -4,6 +4,7 @@
 #include "sim/scene/scene.hpp"
 #include "sim/shell/dof_map.hpp"
 #include "sim/study/report_format.hpp"
+#include "sim/subdivision/loop.hpp"
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -30,8 +31,8 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-MethodRun solve_loop_static(Problem problem, Quadrature rule, const std::vector<SurfaceSample>& points) {
-  problem.quadrature = rule;
+// A static solve of `problem` as given (its method and quadrature set by the caller).
+MethodRun solve_static_run(const Problem& problem, const std::vector<SurfaceSample>& points) {
   MethodRun run;
   const Clock::time_point start = Clock::now();
   const StaticResult result = solve_static(problem);
@@ -45,10 +46,33 @@ MethodRun solve_loop_static(Problem problem, Quadrature rule, const std::vector<
   return run;
 }
 
-MethodRun run_loop_dynamic(Problem problem, Quadrature rule, const std::vector<SurfaceSample>& points,
-                           const std::vector<double>& times) {
-  if (times.empty()) throw std::invalid_argument("run_loop_dynamic: no sample times");
-  problem.quadrature = rule;
+// The surface whose folds are counted, for node positions x [m]: a smooth drawing at
+// kFoldSurfaceLevels. loop_kl: its drawn surface (the display operator, limit points of the
+// refined control net). A flat method's drawn surface is its facets — a 14-gon's corners stand
+// 1.3 mm off the circle, above the fold counter's 1 mm prominence — so its nodes are drawn through
+// the same subdivision scheme instead: kFoldSurfaceLevels Loop steps of the node mesh (crease
+// rules at the rims, sim/subdivision/loop.hpp).
+void fold_surface(const Discretization& d, const Eigen::VectorXd& x, Eigen::MatrixX3d& points,
+                  std::vector<Triangle>& triangles) {
+  if (d.method() == "loop_kl") {
+    const SurfaceOperator drawn = d.display(kFoldSurfaceLevels);
+    points = d.surface_positions(drawn, x);
+    triangles = drawn.triangles;
+    return;
+  }
+  TriMesh mesh;
+  mesh.vertices = d.control_net(x);
+  mesh.triangles = d.mesh().triangles;
+  for (int level = 0; level < kFoldSurfaceLevels; ++level) mesh = loop_subdivide(mesh);
+  points = std::move(mesh.vertices);
+  triangles = std::move(mesh.triangles);
+}
+
+// A dynamic run of `problem` as given (its method and quadrature set by the caller) to the last
+// sample time; also reports the elastic energy and the drawn surface there.
+MethodRun run_dynamic_simulation(Problem problem, const std::vector<SurfaceSample>& points,
+                                 const std::vector<double>& times) {
+  if (times.empty()) throw std::invalid_argument("run_dynamic_simulation: no sample times");
   problem.time.end = times.back();
   const double slack = 1e-9 * problem.time.dt;
   MethodRun run;
@@ -73,7 +97,18 @@ MethodRun run_loop_dynamic(Problem problem, Quadrature rule, const std::vector<S
   const SurfaceOperator sampling = d.samples(points);
   const Eigen::MatrixX3d rest = d.surface_positions(sampling, d.rest());
   for (const Eigen::VectorXd& x : snapshots) run.displacements.push_back(d.surface_positions(sampling, x) - rest);
+  // The loop ends at the step that reaches the last sample time: the state is the run's end.
+  run.final_elastic_energy = sim.elastic_energy();
+  fold_surface(d, sim.state().x, run.final_surface, run.final_surface_triangles);
   return run;
+}
+
+std::string flat_baseline_unsupported(const std::string& discretization, const Problem& problem) {
+  for (const BoundaryCondition& bc : problem.boundary)
+    if (bc.clamped || bc.symmetric)
+      return discretization + " has no rotational degrees of freedom: \"" + (bc.clamped ? "clamped" : "symmetry") +
+             "\" borders are not supported";
+  return "";
 }
 
 // sqrt(2 · area / #triangles) of the rest mesh [m]: the edge length of a uniform right-triangle
@@ -157,8 +192,10 @@ class SleeveScene {
                                                      "full \"cylinder\" primitive");
   }
 
-  Problem problem(const SleeveMesh& m, double dt) const {
+  // The scene with the given mesh, time step and discretisation (its mesh prepared for it).
+  Problem problem(const SleeveMesh& m, double dt, const std::string& discretization) const {
     nlohmann::json j = json_;
+    j["method"] = discretization;
     j["mesh"]["segments"] = m.segments;
     j["mesh"]["rings"] = m.rings;
     j["time"]["dt"] = dt;
@@ -176,6 +213,9 @@ struct Outcome {
   MethodRun run;
   double h = 0.0;
   std::string failure;  // empty on success
+  // The post-buckling measures at the end of the run (none if the method did not report them).
+  std::optional<double> energy;                          // [J]
+  std::optional<double> folds_circumferential, folds_axial;  // medians (count_sleeve_folds)
 };
 
 const Method& find_method(const std::vector<Method>& methods, const std::vector<Method>& registered,
@@ -212,9 +252,15 @@ class StudyRunner {
   void run_plate(const PlateStudyCase& c, std::vector<ConvergenceRow>& rows) {
     for (const Method& method : methods_) {
       if (!method.solve_static) continue;
+      if (const std::string why = unsupported(method, plate_problem(c.plate, c.divisions.front(), Quadrature::one_point));
+          !why.empty()) {
+        skip(c.plate.id, method, why);
+        continue;
+      }
       for (int n : c.divisions) {
         // The method sets its own quadrature; the problem carries the default.
-        const Problem problem = plate_problem(c.plate, n, Quadrature::one_point);
+        Problem problem = plate_problem(c.plate, n, Quadrature::one_point);
+        problem.method = method.discretization;
         const Eigen::MatrixX2d chart = problem.mesh.vertices.leftCols<2>();  // (x, y) [m]
         const std::vector<SurfaceSample> centre =
             locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
@@ -258,6 +304,9 @@ class StudyRunner {
     cache_.clear();
 
     const Outcome& reference = outcome(c, scene, times, reference_method, c.reference_mesh, c.reference_dt);
+    if (!reference.failure.empty() || !reference.energy)
+      log_line("case " + c.name + ": the reference run " +
+               (reference.failure.empty() ? std::string("reported no end state") : "failed: " + reference.failure));
     const std::string reference_text =
         "finest run: " + reference_method.name + " " + sleeve_setting(c.reference_mesh, c.reference_dt);
 
@@ -288,6 +337,7 @@ class StudyRunner {
             row.value = rms_norm(u);
             row.error = relative_rms_difference(u, u_ref);
             if (&o == &reference) row.note = "the reference run itself (error 0 by definition)";
+            fill_post_buckling(row, o, reference);
           }
         }
         report(row);
@@ -298,8 +348,17 @@ class StudyRunner {
     add(reference_method, "reference", c.reference_mesh, c.reference_dt);
     for (const Method& method : methods_) {
       if (!method.run_dynamic) continue;
+      if (const std::string why = unsupported(method, scene.problem(c.reference_mesh, c.reference_dt, method.discretization));
+          !why.empty()) {
+        skip(c.name, method, why);
+        continue;
+      }
       for (const SleeveMesh& m : c.meshes) add(method, "mesh", m, c.mesh_dt);
-      for (double dt : c.dts) add(method, "dt", c.dt_mesh, dt);
+      const bool dt_series = c.dt_series_methods.empty() ||
+                             std::find(c.dt_series_methods.begin(), c.dt_series_methods.end(), method.name) !=
+                                 c.dt_series_methods.end();
+      if (dt_series)
+        for (double dt : c.dts) add(method, "dt", c.dt_mesh, dt);
     }
   }
 
@@ -323,6 +382,34 @@ class StudyRunner {
     row.solver_iterations = run.solver_iterations;
   }
 
+  static std::string unsupported(const Method& method, const Problem& problem) {
+    return method.unsupported ? method.unsupported(problem) : std::string();
+  }
+
+  void skip(const std::string& case_name, const Method& method, const std::string& why) const {
+    log_line("case " + case_name + " method " + method.name + " skipped: " + why);
+  }
+
+  void log_line(const std::string& line) const {
+    if (log_) log_(line);
+  }
+
+  // The post-buckling columns of a sleeve row: the run's end state against the reference's.
+  static void fill_post_buckling(ConvergenceRow& row, const Outcome& o, const Outcome& reference) {
+    row.elastic_energy = o.energy;
+    row.reference_elastic_energy = reference.energy;
+    if (o.energy && reference.energy)
+      row.energy_error = std::abs(*o.energy - *reference.energy) / std::abs(*reference.energy);
+    row.folds_circumferential = o.folds_circumferential;
+    row.folds_axial = o.folds_axial;
+    row.reference_folds_circumferential = reference.folds_circumferential;
+    row.reference_folds_axial = reference.folds_axial;
+    if (o.folds_circumferential && reference.folds_circumferential)
+      row.fold_difference_circumferential = *o.folds_circumferential - *reference.folds_circumferential;
+    if (o.folds_axial && reference.folds_axial)
+      row.fold_difference_axial = *o.folds_axial - *reference.folds_axial;
+  }
+
   static void mark_failed(ConvergenceRow& row, const std::string& why) {
     row.error = std::numeric_limits<double>::quiet_NaN();
     row.note = "failed: " + why;
@@ -342,13 +429,22 @@ class StudyRunner {
     const std::string key = method.name + " " + sleeve_setting(m, dt);
     if (auto it = cache_.find(key); it != cache_.end()) return it->second;
     Outcome o;
-    const Problem problem = scene.problem(m, dt);
+    const Problem problem = scene.problem(m, dt, method.discretization);
     o.h = mesh_size(problem.mesh);
     const std::vector<SurfaceSample> points =
         locate_points(problem.mesh.triangles, cylinder_chart(problem.mesh.vertices),
                       cylinder_parameter_grid(c.grid_theta, c.grid_s), 2 * std::numbers::pi);
     try {
       o.run = method.run_dynamic(problem, points, times);
+      if (std::isfinite(o.run.final_elastic_energy)) o.energy = o.run.final_elastic_energy;
+      if (o.run.final_surface_triangles.size() > 0) {
+        const SleeveFolds folds = count_sleeve_folds(o.run.final_surface, o.run.final_surface_triangles, c.fold_axis);
+        o.folds_circumferential = folds.circumferential_median;
+        o.folds_axial = folds.axial.median_count;
+      }
+      // The surfaces are large (kFoldSurfaceLevels); only the counts are kept.
+      o.run.final_surface.resize(0, 3);
+      o.run.final_surface_triangles.clear();
     } catch (const std::exception& e) {
       o.failure = e.what();
     }
@@ -385,11 +481,41 @@ Method loop_subdivision_method(const std::string& name, Quadrature rule) {
   Method m;
   m.name = name;
   m.description = std::string("Loop subdivision shell element, ") + to_string(rule) + " quadrature";
-  m.solve_static = [rule](const Problem& problem, const std::vector<SurfaceSample>& points) {
-    return solve_loop_static(problem, rule, points);
+  m.discretization = "loop_kl";
+  m.solve_static = [rule](Problem problem, const std::vector<SurfaceSample>& points) {
+    problem.method = "loop_kl";
+    problem.quadrature = rule;
+    return solve_static_run(problem, points);
   };
-  m.run_dynamic = [rule](const Problem& problem, const std::vector<SurfaceSample>& points,
-                         const std::vector<double>& times) { return run_loop_dynamic(problem, rule, points, times); };
+  m.run_dynamic = [rule](Problem problem, const std::vector<SurfaceSample>& points, const std::vector<double>& times) {
+    problem.method = "loop_kl";
+    problem.quadrature = rule;
+    return run_dynamic_simulation(std::move(problem), points, times);
+  };
+  return m;
+}
+
+Method flat_baseline_method(const std::string& discretization) {
+  if (discretization != "linear_fe" && discretization != "mass_spring")
+    throw std::invalid_argument("flat_baseline_method: unknown baseline \"" + discretization +
+                                "\" (known: linear_fe, mass_spring)");
+  Method m;
+  m.name = discretization;
+  m.discretization = discretization;
+  m.description = discretization == "linear_fe"
+                      ? "flat corotated membrane triangles with dihedral-angle hinge bending (docs/linear_fe.md)"
+                      : "edge and bending springs on the flat triangles, dynamic only (docs/mass_spring.md)";
+  m.unsupported = [discretization](const Problem& problem) { return flat_baseline_unsupported(discretization, problem); };
+  if (discretization == "linear_fe")
+    m.solve_static = [discretization](Problem problem, const std::vector<SurfaceSample>& points) {
+      problem.method = discretization;
+      return solve_static_run(problem, points);
+    };
+  m.run_dynamic = [discretization](Problem problem, const std::vector<SurfaceSample>& points,
+                                   const std::vector<double>& times) {
+    problem.method = discretization;
+    return run_dynamic_simulation(std::move(problem), points, times);
+  };
   return m;
 }
 
@@ -397,6 +523,8 @@ std::vector<Method> convergence_methods() {
   return {
       loop_subdivision_method("loop_one_point", Quadrature::one_point),
       loop_subdivision_method("loop_three_point", Quadrature::three_point),
+      flat_baseline_method("linear_fe"),
+      flat_baseline_method("mass_spring"),
   };
 }
 
@@ -425,6 +553,9 @@ ConvergencePlan full_convergence_plan(const std::filesystem::path& scenes_dir) {
     c.mesh_dt = 5e-4;
     c.dt_mesh = meshes.back();
     c.dts = {4e-3, 2e-3, 1e-3, 5e-4};
+    // The baselines run the mesh series only (their 52 × 37 runs are the study's most expensive:
+    // docs/convergence.md, "Run times").
+    c.dt_series_methods = {"loop_one_point", "loop_three_point"};
     c.reference_mesh = meshes.back();
     c.reference_dt = 5e-4;
     plan.sleeves.push_back(c);
@@ -445,6 +576,7 @@ ConvergencePlan quick_convergence_plan(const std::filesystem::path& scenes_dir) 
   c.mesh_dt = 2e-3;
   c.dt_mesh = {12, 9};
   c.dts = {1e-2, 5e-3, 2e-3};
+  c.dt_series_methods = {"loop_one_point", "loop_three_point"};  // as the full plan
   c.reference_mesh = {16, 11};
   c.reference_dt = 1e-3;
   plan.sleeves.push_back(c);
@@ -466,9 +598,18 @@ const std::vector<std::string>& results_csv_columns() {
       "case",     "method", "series",          "window",              "setting",   "vertices", "dofs",
       "h",        "dt",     "steps",           "wall_seconds",        "solver_iterations",     "error",
       "order",    "quantity", "value",         "reference_value",     "reference_precision",   "reference",
-      "note"};
+      "note",     "elastic_energy", "reference_elastic_energy", "energy_error", "folds_circumferential", "folds_axial",
+      "reference_folds_circumferential", "reference_folds_axial", "fold_difference_circumferential",
+      "fold_difference_axial"};
   return columns;
 }
+
+namespace {
+
+// An optional number: empty when absent, else the shortest exact form ("nan" for NaN).
+std::string optional_number(const std::optional<double>& x) { return x ? format_shortest(*x) : std::string(); }
+
+}  // namespace
 
 void write_results_csv(std::ostream& out, const std::vector<ConvergenceRow>& rows) {
   const std::vector<std::string>& columns = results_csv_columns();
@@ -482,18 +623,31 @@ void write_results_csv(std::ostream& out, const std::vector<ConvergenceRow>& row
         << (r.order ? format_shortest(*r.order) : "") << ',' << csv_field(r.quantity) << ','
         << format_shortest(r.value) << ',' << format_shortest(r.reference_value) << ','
         << format_shortest(r.reference_precision) << ',' << csv_field(r.reference)
-        << ',' << csv_field(r.note) << '\n';
+        << ',' << csv_field(r.note) << ',' << optional_number(r.elastic_energy) << ','
+        << optional_number(r.reference_elastic_energy) << ',' << optional_number(r.energy_error) << ','
+        << optional_number(r.folds_circumferential) << ',' << optional_number(r.folds_axial) << ','
+        << optional_number(r.reference_folds_circumferential) << ',' << optional_number(r.reference_folds_axial) << ','
+        << optional_number(r.fold_difference_circumferential) << ',' << optional_number(r.fold_difference_axial)
+        << '\n';
 }
 
 void write_results_markdown(std::ostream& out, const std::vector<ConvergenceRow>& rows) {
   out << "| case | method | series | window | setting | vertices | dofs | dt [s] | wall [s] | solver iterations | "
-         "error | order |\n|---|---|---|---|---|--:|--:|--:|--:|--:|--:|--:|\n";
+         "error | order | energy error | folds circ. / axial (ref.) |\n"
+         "|---|---|---|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
+  auto folds = [](const ConvergenceRow& r) -> std::string {
+    if (!r.folds_circumferential && !r.folds_axial) return "";
+    auto count = [](const std::optional<double>& x) { return x ? format_shortest(*x) : std::string("–"); };
+    return count(r.folds_circumferential) + " / " + count(r.folds_axial) + " (" +
+           count(r.reference_folds_circumferential) + " / " + count(r.reference_folds_axial) + ")";
+  };
   for (const ConvergenceRow& r : rows)
     out << "| " << markdown_cell(r.case_name) << " | " << markdown_cell(r.method) << " | " << r.series << " | "
         << markdown_cell(r.window) << " | " << markdown_cell(r.setting) << " | " << r.vertices << " | " << r.dofs << " | "
         << (r.dt > 0 ? format_shortest(r.dt) : "–") << " | " << format_fixed(r.wall_seconds, 3) << " | "
         << r.solver_iterations << " | " << format_significant(r.error, 3) << " | "
-        << (r.order ? format_fixed(*r.order, 2) : "") << " |\n";
+        << (r.order ? format_fixed(*r.order, 2) : "") << " | "
+        << (r.energy_error ? format_significant(*r.energy_error, 3) : "") << " | " << folds(r) << " |\n";
 }
 
 }  // namespace clothsim

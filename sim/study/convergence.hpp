@@ -4,9 +4,9 @@
 // A *case* is a problem with a reference solution: the four square plates of sim/study/plates.hpp
 // (reference: the analytic centre deflection) and the dynamic sleeve scenes (reference: the finest
 // run of the same scene, a designated method on the finest mesh at the finest time step). A
-// *method* is a named way to discretise and solve a case (now the Loop subdivision element with
-// one- or three-point quadrature; baselines such as a linear FE or hinge bending are added by
-// registering one more Method in convergence_methods()). A *setting* is the resolution (and time
+// *method* is a named way to discretise and solve a case (the Loop subdivision element with one-
+// or three-point quadrature, and the baselines linear_fe and mass_spring on the flat triangles;
+// each is one Method in convergence_methods()). A *setting* is the resolution (and time
 // step) of one run. Every run of a method on a case at a setting gives one row of results.csv
 // (a sleeve run one row per error window).
 //
@@ -20,6 +20,11 @@
 //    the window's times, i.e. RMS(|u − u_ref|) / RMS(|u_ref|) (surface_sampling.hpp). The full
 //    plan has an "early" window that ends before the sleeves' first buckling bifurcation and a
 //    "long" one to 0.2 s, after it (docs/convergence.md explains why both).
+//  - sleeves after buckling (pointwise displacement is no measure there): at the end of each run
+//    (its last sample time), the elastic energy E (Simulator::elastic_energy) and the fold counts of
+//    the drawn surface (count_sleeve_folds, sim/study/fold_count.hpp: circumferential median over
+//    the heights, axial median over the meridians), each against the reference run's:
+//    |E − E_ref| / |E_ref| and count − count_ref.
 // Wall time: std::chrono::steady_clock around the solve only — static: solve_static (assembly,
 // factorisation, solve); dynamic: constructing the Simulator plus all its steps. Building the
 // problem (mesh, scene) and evaluating the error are not included. Static solves that take
@@ -32,6 +37,7 @@
 #include "sim/problem/problem.hpp"
 #include "sim/shell/quadrature.hpp"
 #include "sim/static/static_solve.hpp"
+#include "sim/study/fold_count.hpp"
 #include "sim/study/plates.hpp"
 #include "sim/study/surface_sampling.hpp"
 
@@ -39,6 +45,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -57,7 +64,19 @@ struct MethodRun {
   // Surface displacement [m] at the requested points: one #P × 3 matrix per requested sample time
   // (a static solve: one matrix).
   std::vector<Eigen::MatrixX3d> displacements;
+  // Dynamic runs, at the last sample time (the end of the run); left empty / NaN by a method that
+  // does not report them (its rows then have empty post-buckling columns):
+  double final_elastic_energy = std::numeric_limits<double>::quiet_NaN();  // [J]
+  // [m] points of the surface whose folds are counted (kFoldSurfaceLevels) and its triangles
+  Eigen::MatrixX3d final_surface;
+  std::vector<Triangle> final_surface_triangles;
 };
+
+// Refinement levels of the surface whose folds are counted, the same for every method: loop_kl's
+// display operator (Discretization::display) at this level; a flat method's nodes through this
+// many Loop subdivision steps (its own display operator keeps the facets, whose corners on a
+// coarse sleeve would count as folds). docs/convergence.md, "Post-buckling measures".
+inline constexpr int kFoldSurfaceLevels = 2;
 
 // A named way to discretise and solve a case. `points` are parameter points of the problem's
 // control mesh (its triangles and barycentric coordinates); `times` [s] are increasing sample
@@ -67,6 +86,13 @@ struct MethodRun {
 struct Method {
   std::string name;         // the CSV's "method" column, e.g. "loop_one_point"
   std::string description;  // one line for logs and docs
+  // The discretisation (Problem::method, sim/setup/setup.hpp) the study builds the problem for:
+  // a sleeve's scene is loaded with this "method", so its mesh is prepared for it and the
+  // parameter points lie on that mesh; a plate's Problem gets it.
+  std::string discretization = "loop_kl";
+  // Optional: the reason the method cannot take a case's problem (e.g. clamped borders), or ""
+  // when it can. A case it cannot take is skipped (no rows; a log line says why).
+  std::function<std::string(const Problem& problem)> unsupported;
   std::function<MethodRun(const Problem& problem, const std::vector<SurfaceSample>& points)> solve_static;
   std::function<MethodRun(const Problem& problem, const std::vector<SurfaceSample>& points,
                           const std::vector<double>& times)>
@@ -77,8 +103,14 @@ struct Method {
 // Simulator, the displacement evaluated on the limit surface.
 Method loop_subdivision_method(const std::string& name, Quadrature rule);
 
-// The registered methods, in plotting order: "loop_one_point", "loop_three_point". Later
-// baselines ("linear_fe", "hinge_bending") are added here, one line each.
+// A piecewise-flat baseline (sim/flat_fe/): "linear_fe" (corotated membrane triangles with hinge
+// bending; static and dynamic; not for clamped or symmetry borders) or "mass_spring" (edge and
+// bending springs; dynamic only). The displacement at a parameter point is the barycentric
+// interpolation of the nodal displacements (the flat surface's samples operator).
+Method flat_baseline_method(const std::string& discretization);
+
+// The registered methods, in plotting order: "loop_one_point", "loop_three_point", "linear_fe",
+// "mass_spring".
 std::vector<Method> convergence_methods();
 
 // Resolution of a sleeve's cylinder primitive: vertices around × rings along the axis.
@@ -110,9 +142,14 @@ struct SleeveStudyCase {
   double mesh_dt = 1e-3;           // [s]
   SleeveMesh dt_mesh;              // time-step series on this mesh, time steps `dts`
   std::vector<double> dts;         // [s], large to small
+  // Methods that also run the time-step series (the others run the mesh series only); empty: all.
+  std::vector<std::string> dt_series_methods;
   SleeveMesh reference_mesh;       // the reference run: this mesh, reference_dt, reference_method
   double reference_dt = 5e-4;      // [s]
   std::string reference_method = "loop_three_point";
+  // The rest cylinder's axis, for the fold counts (the scenes' cylinder primitive: the y axis from
+  // the origin; θ = 0 along x).
+  FoldAxis fold_axis;
 };
 
 struct ConvergencePlan {
@@ -120,8 +157,8 @@ struct ConvergencePlan {
   std::vector<SleeveStudyCase> sleeves;
 };
 
-// The full study (docs/convergence.md: ~10 minutes on 2 cores, Release) and a tiny one for the
-// tests (a few seconds). `scenes_dir` is the folder holding sleeve_*.json.
+// The full study (docs/convergence.md: about 20 minutes on 2 cores, Release) and a tiny one for
+// the tests (a few seconds). `scenes_dir` is the folder holding sleeve_*.json.
 ConvergencePlan full_convergence_plan(const std::filesystem::path& scenes_dir);
 ConvergencePlan quick_convergence_plan(const std::filesystem::path& scenes_dir);
 
@@ -151,6 +188,16 @@ struct ConvergenceRow {
                                      // of the published coefficient; sleeves: 0)
   std::string reference;   // what the reference is
   std::string note;        // empty, or e.g. the reason a run failed
+  // Post-buckling measures (sleeves; empty for plates and failed runs): at the end of the run.
+  std::optional<double> elastic_energy;            // [J] E
+  std::optional<double> reference_elastic_energy;  // [J] E_ref
+  std::optional<double> energy_error;              // |E − E_ref| / |E_ref| [-]
+  std::optional<double> folds_circumferential;     // median fold count over the height sections
+  std::optional<double> folds_axial;               // median fold count over the meridians
+  std::optional<double> reference_folds_circumferential;
+  std::optional<double> reference_folds_axial;
+  std::optional<double> fold_difference_circumferential;  // folds − reference folds
+  std::optional<double> fold_difference_axial;
 };
 
 // Progress lines ("case ... method ... setting ... error ... (x s)") go to `log` (may be empty).
@@ -163,12 +210,15 @@ std::vector<ConvergenceRow> run_convergence(const ConvergencePlan& plan, const s
 
 // The CSV columns, in order: case, method, series, window, setting, vertices, dofs, h, dt, steps,
 // wall_seconds, solver_iterations, error, order, quantity, value, reference_value,
-// reference_precision, reference, note.
+// reference_precision, reference, note, elastic_energy, reference_elastic_energy, energy_error,
+// folds_circumferential, folds_axial, reference_folds_circumferential, reference_folds_axial,
+// fold_difference_circumferential, fold_difference_axial.
 const std::vector<std::string>& results_csv_columns();
 
 // Writes the header line and one line per row (RFC 4180 quoting where needed; numbers in the
 // shortest form that reads back exactly, wall_seconds to the microsecond, empty order for the
-// first row of a series, "nan" for a failed run's error).
+// first row of a series, "nan" for a failed run's error, empty post-buckling columns where a row
+// has none).
 void write_results_csv(std::ostream& out, const std::vector<ConvergenceRow>& rows);
 
 // A Markdown table of the rows (case, method, series, window, setting, vertices, dofs, dt, wall time,

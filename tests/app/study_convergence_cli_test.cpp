@@ -10,10 +10,13 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -23,7 +26,9 @@ using clothsim::testing::shell_quote;
 
 const char* const kHeader =
     "case,method,series,window,setting,vertices,dofs,h,dt,steps,wall_seconds,solver_iterations,error,order,quantity,"
-    "value,reference_value,reference_precision,reference,note";
+    "value,reference_value,reference_precision,reference,note,elastic_energy,reference_elastic_energy,energy_error,"
+    "folds_circumferential,folds_axial,reference_folds_circumferential,reference_folds_axial,"
+    "fold_difference_circumferential,fold_difference_axial";
 
 // Runs a shell command; returns its exit status (-1 if it did not exit normally).
 int run_shell(const std::string& command) {
@@ -32,6 +37,19 @@ int run_shell(const std::string& command) {
 }
 
 std::string first_line(const std::string& text) { return text.substr(0, text.find('\n')); }
+
+// The error field (the 13th, before any quoted field) of every CSV line that starts with `prefix`.
+std::vector<std::string> errors_of(const std::string& csv, const std::string& prefix) {
+  std::vector<std::string> out;
+  std::istringstream in(csv);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind(prefix, 0) != 0) continue;
+    size_t start = 0;
+    for (int field = 0; field < 12; ++field) start = line.find(',', start) + 1;
+    out.push_back(line.substr(start, line.find(',', start) - start));
+  }
+  return out;
+}
 
 class StudyConvergenceCli : public ::testing::Test {
  protected:
@@ -73,8 +91,20 @@ TEST_F(StudyConvergenceCli, QuickWithoutPlotWritesTheCsv) {
       << err_;
   const std::string csv = read_file_bytes(report() / "results.csv");
   EXPECT_EQ(first_line(csv), kHeader);
-  // Quick plan: 1 plate case × 2 methods × 3 grids, and 1 sleeve: reference + 2 methods × (2 meshes + 3 steps).
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 6 + 1 + 10);
+  // Quick plan: 1 plate case × 3 static methods (mass_spring is dynamic only) × 3 grids, and 1 sleeve:
+  // reference + 2 Loop rules × (2 meshes + 3 steps) + 2 baselines × 2 meshes (mesh series only).
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 9 + 1 + 10 + 4);
+  // The baselines' rows have finite errors.
+  for (const std::string prefix : {"plate_ss_uniform,linear_fe,mesh,", "sleeve_twist,linear_fe,mesh,",
+                                   "sleeve_twist,mass_spring,mesh,"}) {
+    const std::vector<std::string> errors = errors_of(csv, prefix);
+    EXPECT_EQ(errors.size(), prefix[0] == 'p' ? 3u : 2u) << prefix;
+    for (const std::string& e : errors) {
+      char* end = nullptr;
+      const double value = std::strtod(e.c_str(), &end);
+      EXPECT_TRUE(end != e.c_str() && *end == '\0' && std::isfinite(value) && value > 0) << prefix << " error " << e;
+    }
+  }
   EXPECT_TRUE(fs::exists(report() / "results.md"));
   EXPECT_FALSE(fs::exists(report() / "error_vs_time.png"));
   expect_only_the_report_in_out();
