@@ -2,7 +2,8 @@
 // (sim/study/convergence.hpp, docs/convergence.md) and writes DIR/study_convergence/:
 //   results.csv        one row per run (columns: results_csv_columns())
 //   results.md         the same rows as a Markdown table
-//   error_vs_time.png  log–log error against wall time (scripts/plot_convergence.py, matplotlib)
+//   error_vs_time.png  log–log error against wall time, and per sleeve the post-buckling panels
+//                      (energy error, fold counts) (scripts/plot_convergence.py, matplotlib)
 // The folder is built as DIR/.study_convergence.tmp-<pid> and renamed into place at the end; an
 // older report is replaced only then. If only the plot fails, the folder (with the CSV) is still
 // published and the command exits with 1.

@@ -28,6 +28,7 @@ try:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 except ImportError:
     sys.stderr.write("plot_convergence.py: matplotlib is not installed (Debian: python3-matplotlib)\n")
     sys.exit(3)
@@ -159,8 +160,10 @@ def draw_fold_panel(ax, rows, case, colour):
                 value = number(r, column)
                 if value is not None:
                     ax.axhline(value, color="0.55", linestyle=style, linewidth=1.2, zorder=0)
+                    above = column == "folds_circumferential"  # the axial label goes below its line
                     ax.annotate(f"reference {column.split('_')[1]}: {value:g}", (0.99, value),
-                                xycoords=("axes fraction", "data"), ha="right", va="bottom", fontsize=6.5, color="0.4")
+                                xycoords=("axes fraction", "data"), ha="right", va="bottom" if above else "top",
+                                fontsize=6.5, color="0.4")
             break
     curves = {}
     for r in end_state_rows(rows, case):
@@ -177,6 +180,8 @@ def draw_fold_panel(ax, rows, case, colour):
                 markersize=5)
         drawn = True
     ax.set_xscale("log")
+    ax.yaxis.set_major_locator(matplotlib.ticker.MaxNLocator(integer=True))
+    ax.set_ylim(bottom=-0.5)
     ax.set_xlabel("control vertices (mesh series)")
     ax.set_ylabel("folds at the end of the run")
     ax.set_title(f"{case}: fold count of the drawn surface (count_sleeve_folds)", fontsize=10)
