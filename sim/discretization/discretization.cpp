@@ -15,4 +15,13 @@ void SurfaceOperator::evaluate(const Eigen::MatrixX3d& net, Eigen::MatrixX3d& po
   }
 }
 
+SurfaceOperator Discretization::drawn_display(int levels, DrawnSurface surface) const {
+  switch (surface) {
+    case DrawnSurface::loop_limit: return loop_limit_display(levels);
+    case DrawnSurface::flat: return flat_display(levels);
+    case DrawnSurface::method: break;
+  }
+  return display(levels);
+}
+
 }  // namespace clothsim

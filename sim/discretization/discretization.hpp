@@ -20,6 +20,7 @@
 #pragma once
 
 #include "sim/core/layout.hpp"
+#include "sim/discretization/drawn_surface.hpp"
 #include "sim/forces/force_term.hpp"
 #include "sim/mesh/mesh.hpp"
 
@@ -109,6 +110,20 @@ class Discretization {
   // The surface refined for display: `levels` ≥ 0 steps of the method's refinement, then its
   // surface points, with tangents and triangles.
   virtual SurfaceOperator display(int levels) const = 0;
+  // The Loop limit surface whose control vertices are the nodes, refined for display `levels`
+  // steps (k Loop steps, then the limit masks; sim/subdivision/limit_refinement.hpp), with the
+  // ghost layer at open borders built by the free-border rule x_g = x_a + x_b − x_c
+  // (sim/shell/ghost_layer.hpp) — an operator over this discretisation's control net. The Loop
+  // shell's own display(levels); for a flat discretisation a picture of the smooth surface its
+  // nodes span (not the surface it computes with).
+  virtual SurfaceOperator loop_limit_display(int levels) const = 0;
+  // The flat triangles of the prepared mesh over the nodes, refined `levels` times by midpoint
+  // subdivision (sim/discretization/flat_refinement.hpp) — an operator over the control net. A
+  // flat discretisation's own display(levels); for the Loop shell its control mesh drawn flat.
+  virtual SurfaceOperator flat_display(int levels) const = 0;
+  // The surface drawn for `surface` ("render.surface"): display, loop_limit_display or
+  // flat_display.
+  SurfaceOperator drawn_display(int levels, DrawnSurface surface) const;
   // f += Jᵀ F: the nodal forces (3·#nodes) [N] equivalent to forces F (#P × 3) [N] applied at the
   // operator's points (J the derivative of the points' positions with respect to the node
   // positions, the transpose of the operator composed with the control net).
@@ -119,6 +134,13 @@ class Discretization {
   // ones are folded in through their rule), so a change of the free components moves the points
   // by J δv exactly once make_consistent() has derived the dependent ones.
   virtual Eigen::SparseMatrix<double, Eigen::RowMajor> point_jacobian(const SurfaceOperator& op) const = 0;
+
+  // --- Strain ---------------------------------------------------------------------------------
+  // Largest |principal Green–Lagrange membrane strain| [-] over the surface for displacements u
+  // (3·#nodes, from the rest state; dependent components are derived here) [m]: for the Loop
+  // shell of its limit surface at each element's barycentre, for a flat discretisation of each
+  // flat triangle (constant over it). A uniform stretch by λ gives ½(λ² − 1); a rigid motion 0.
+  virtual double max_membrane_strain(const Eigen::VectorXd& u) const = 0;
 
   // Convenience: positions (#P × 3) [m] of an operator's points for node positions x.
   Eigen::MatrixX3d surface_positions(const SurfaceOperator& op, const Eigen::VectorXd& x) const {

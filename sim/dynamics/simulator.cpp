@@ -169,9 +169,7 @@ double Simulator::elastic_energy() const { return impl_->integrator->elastic_ene
 double Simulator::external_work() const { return impl_->integrator->external_work(); }
 double Simulator::boundary_work() const { return impl_->integrator->boundary_work(); }
 double Simulator::max_membrane_strain() const {
-  if (!impl_->shell) return std::numeric_limits<double>::quiet_NaN();
-  const Eigen::MatrixX2d strains = impl_->shell->elements().membrane_principal_strains(impl_->integrator->displacement());
-  return strains.size() > 0 ? strains.cwiseAbs().maxCoeff() : 0.0;
+  return impl_->discretization->max_membrane_strain(impl_->integrator->displacement());
 }
 const Eigen::VectorXd& Simulator::vertex_mass() const { return impl_->node_mass; }
 

@@ -59,10 +59,10 @@ class Simulator {
   double elastic_energy() const;
   double external_work() const;
   double boundary_work() const;
-  // Largest |principal Green–Lagrange membrane strain| of the limit surface at the element
-  // barycentres in the current state [-] (CorotationalElements::membrane_principal_strains);
-  // computed on demand, a pass over the elements. NaN when the elastic term is not the corotated
-  // shell.
+  // Largest |principal Green–Lagrange membrane strain| of the surface in the current state [-]
+  // (Discretization::max_membrane_strain: for loop_kl of the limit surface at the element
+  // barycentres, for linear_fe and mass_spring of the flat triangles); computed on demand, a pass
+  // over the elements.
   double max_membrane_strain() const;
   // Lumped mass per node [kg] (areal density × a third of the incident area).
   const Eigen::VectorXd& vertex_mass() const;

@@ -1,9 +1,12 @@
 #include "sim/flat_fe/flat_fe.hpp"
 
+#include "sim/discretization/flat_refinement.hpp"
 #include "sim/flat_fe/flat_fe_term.hpp"
 #include "sim/mesh/topology.hpp"
+#include "sim/shell/dof_map.hpp"
+#include "sim/shell/ghost_layer.hpp"
 #include "sim/shell/shell_model.hpp"
-#include "sim/subdivision/loop.hpp"
+#include "sim/subdivision/limit_refinement.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -164,82 +167,62 @@ SurfaceOperator FlatDiscretization::samples(const std::vector<SurfaceSample>& po
 }
 
 SurfaceOperator FlatDiscretization::display(int levels) const {
+  return midpoint_display(mesh_, levels, mesh_.num_vertices());
+}
+
+SurfaceOperator FlatDiscretization::loop_limit_display(int levels) const {
   if (levels < 0) throw std::invalid_argument("display: levels must be >= 0");
-  // Midpoint subdivision, composed: fine vertex positions = S · nodes. The topology of each step
-  // (vertex and triangle numbering, child order) is Loop's (sim/subdivision/loop.hpp); only the
-  // weights differ: old vertices stay, edge vertices are the edge midpoints.
-  using Sparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-  const Eigen::Index n0 = mesh_.num_vertices();
-  Sparse s(n0, n0);
-  s.setIdentity();
-  std::vector<Triangle> tris = mesh_.triangles;
-  Eigen::MatrixX3d x = mesh_.vertices;
-  for (int level = 0; level < levels; ++level) {
-    const SubdivisionStep step = loop_subdivision_step(x, tris);
-    const Eigen::Index n = x.rows(), fine = step.matrix.rows();
-    std::vector<Eigen::Triplet<double>> w;
-    for (Eigen::Index v = 0; v < n; ++v) w.emplace_back(static_cast<int>(v), static_cast<int>(v), 1.0);
-    std::vector<char> done(static_cast<size_t>(fine), 0);
-    for (size_t t = 0; t < tris.size(); ++t) {
-      // Children: (a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca).
-      const Triangle& parent = tris[t];
-      const int ab = step.triangles[4 * t][1], ca = step.triangles[4 * t][2], bc = step.triangles[4 * t + 1][1];
-      const std::pair<int, std::pair<int, int>> mids[3] = {{ab, {parent[0], parent[1]}},
-                                                          {bc, {parent[1], parent[2]}},
-                                                          {ca, {parent[2], parent[0]}}};
-      for (const auto& [mid, ends] : mids) {
-        if (done[static_cast<size_t>(mid)]) continue;
-        done[static_cast<size_t>(mid)] = 1;
-        w.emplace_back(mid, ends.first, 0.5);
-        w.emplace_back(mid, ends.second, 0.5);
-      }
+  // loop_kl's construction on the same mesh: the ghost layer, then the limit refinement of the
+  // extended mesh, composed with the map from the nodes to the extended mesh's vertices (each
+  // ghost by the free-border rule of a DofMap without conditions, x_g = x_a + x_b − x_c).
+  const ExtendedMesh ext = [&] {
+    try {
+      return build_ghost_layer(mesh_);
+    } catch (const MeshError& e) {
+      throw MeshError(std::string("the Loop limit surface over the ") + method_ + " nodes (\"render.surface\": "
+                      "\"loop_limit\") cannot be built: " + e.what());
     }
-    Sparse m(fine, n);
-    m.setFromTriplets(w.begin(), w.end());
-    s = Sparse(m * s);
-    x = m * x;
-    tris = step.triangles;
-  }
-  // Points in order of first use by the fine triangles; each takes the tangents of the surface
-  // triangle of the first fine triangle that uses it.
-  const size_t per = size_t{1} << (2 * levels);
-  std::vector<int> point_of(static_cast<size_t>(x.rows()), -1);
-  std::vector<int> used, facet;
+  }();
+  const DofMap free_borders(ext, {});
+  std::vector<Eigen::Triplet<double>> g;
+  for (int v = 0; v < ext.num_vertices(); ++v)
+    for (const auto& [dof, w] : free_borders.combination(v, 0)) g.emplace_back(v, dof / 3, w);  // same for y, z
+  Eigen::SparseMatrix<double, Eigen::RowMajor> expand(ext.num_vertices(), mesh_.num_vertices());
+  expand.setFromTriplets(g.begin(), g.end());
+  LimitRefinement r = build_limit_refinement(ext.rest, ext.triangles, ext.num_real_triangles, levels);
   SurfaceOperator op;
-  op.levels = levels;
-  op.triangles.reserve(tris.size());
-  for (size_t t = 0; t < tris.size(); ++t) {
-    Triangle ft;
-    for (int k = 0; k < 3; ++k) {
-      const int v = tris[t][static_cast<size_t>(k)];
-      if (point_of[static_cast<size_t>(v)] < 0) {
-        point_of[static_cast<size_t>(v)] = static_cast<int>(used.size());
-        used.push_back(v);
-        facet.push_back(static_cast<int>(t / per));
-      }
-      ft[static_cast<size_t>(k)] = point_of[static_cast<size_t>(v)];
-    }
-    op.triangles.push_back(ft);
-  }
-  const Eigen::Index np = static_cast<Eigen::Index>(used.size());
-  std::vector<Eigen::Triplet<double>> pick, t1, t2;
-  for (Eigen::Index p = 0; p < np; ++p) {
-    pick.emplace_back(static_cast<int>(p), used[static_cast<size_t>(p)], 1.0);
-    const Triangle& tri = mesh_.triangles[static_cast<size_t>(facet[static_cast<size_t>(p)])];
-    t1.emplace_back(static_cast<int>(p), tri[1], 1.0);
-    t1.emplace_back(static_cast<int>(p), tri[0], -1.0);
-    t2.emplace_back(static_cast<int>(p), tri[2], 1.0);
-    t2.emplace_back(static_cast<int>(p), tri[0], -1.0);
-  }
-  Sparse select(np, x.rows());
-  select.setFromTriplets(pick.begin(), pick.end());
-  op.position = select * s;
+  op.position = r.position * expand;
+  op.tangent1 = r.tangent1 * expand;
+  op.tangent2 = r.tangent2 * expand;
   op.position.prune(0.0, 1e-14);
-  op.tangent1.resize(np, n0);
-  op.tangent1.setFromTriplets(t1.begin(), t1.end());
-  op.tangent2.resize(np, n0);
-  op.tangent2.setFromTriplets(t2.begin(), t2.end());
+  op.tangent1.prune(0.0, 1e-14);
+  op.tangent2.prune(0.0, 1e-14);
+  op.triangles = std::move(r.triangles);
+  op.levels = r.levels;
   return op;
+}
+
+double FlatDiscretization::max_membrane_strain(const Eigen::VectorXd& u) const {
+  // Per triangle: the deformation gradient F (3 × 2) from an orthonormal frame of the rest
+  // triangle's plane to the current positions, F = D_s D_m⁻¹ with D_m the rest edges (b − a,
+  // c − a) in that frame and D_s the current ones; the Green–Lagrange strain ½(FᵀF − I) and its
+  // principal values.
+  double worst = 0.0;
+  for (const Triangle& t : mesh_.triangles) {
+    const Eigen::Vector3d xa = rest_.segment<3>(3 * t[0]), xb = rest_.segment<3>(3 * t[1]), xc = rest_.segment<3>(3 * t[2]);
+    const Eigen::Vector3d e1 = (xb - xa).normalized();
+    const Eigen::Vector3d e2 = ((xb - xa).cross(xc - xa)).cross(xb - xa).normalized();
+    Eigen::Matrix2d dm;
+    dm << e1.dot(xb - xa), e1.dot(xc - xa), e2.dot(xb - xa), e2.dot(xc - xa);
+    Eigen::Matrix<double, 3, 2> ds;
+    ds.col(0) = (xb + u.segment<3>(3 * t[1])) - (xa + u.segment<3>(3 * t[0]));
+    ds.col(1) = (xc + u.segment<3>(3 * t[2])) - (xa + u.segment<3>(3 * t[0]));
+    const Eigen::Matrix<double, 3, 2> f = ds * dm.inverse();
+    const Eigen::Matrix2d green = 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(0.5 * (green + green.transpose()), Eigen::EigenvaluesOnly);
+    worst = std::max(worst, eig.eigenvalues().cwiseAbs().maxCoeff());
+  }
+  return worst;
 }
 
 void FlatDiscretization::add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces,

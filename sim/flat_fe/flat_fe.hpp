@@ -71,14 +71,20 @@ class FlatDiscretization : public Discretization {
   // Barycentric interpolation on the flat triangles.
   SurfaceOperator samples(const std::vector<SurfaceSample>& samples) const override;
   // The flat triangles refined `levels` times by midpoint subdivision, with loop_kl's conventions
-  // (sim/subdivision/limit_refinement.hpp): each step splits triangle (a, b, c) into the corner
-  // triangles of a, b, c and the middle one, in that order, so surface triangle i has the fine
-  // triangles [i·4^levels, (i + 1)·4^levels) and the children of triangle t are 4t … 4t + 3; one
-  // point per position (shared by the fine triangles around it), numbered in order of first use
-  // by the triangles. The points lie on the flat triangles. Tangents: a point takes the two edge
-  // vectors (b − a, c − a) of the first surface triangle it lies on, so its normal is that
-  // facet's normal (flat shading; points on a surface edge or vertex show one neighbour's facet).
+  // (sim/discretization/flat_refinement.hpp, midpoint_display): surface triangle i has the fine
+  // triangles [i·4^levels, (i + 1)·4^levels), the points lie on the flat triangles, and each
+  // point's normal is the normal of the first facet it lies on (flat shading).
   SurfaceOperator display(int levels) const override;
+  SurfaceOperator flat_display(int levels) const override { return display(levels); }
+  // The Loop limit surface with the nodes as control vertices (what loop_kl would draw for the
+  // same mesh, node positions and free borders; the ghost layer of sim/shell/ghost_layer.hpp,
+  // composed into the operator so that its columns are the nodes). Only a picture: forces,
+  // contact, probes and loads stay on the flat triangles. Throws MeshError (naming
+  // "render.surface") when the ghost layer cannot be built (a vertex of valence above 12).
+  SurfaceOperator loop_limit_display(int levels) const override;
+  // Of the flat triangles: the largest |eigenvalue| of ½(FᵀF − I) over the triangles, F the
+  // triangle's deformation gradient from its rest plane (constant strain per triangle).
+  double max_membrane_strain(const Eigen::VectorXd& u) const override;
   void add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces, Eigen::VectorXd& f) const override;
   Eigen::SparseMatrix<double, Eigen::RowMajor> point_jacobian(const SurfaceOperator& op) const override;
 

@@ -1,14 +1,18 @@
 #include "sim/loop_shell/loop_shell.hpp"
 
 #include "sim/core/layout.hpp"
+#include "sim/discretization/flat_refinement.hpp"
 #include "sim/forces/corotated_shell.hpp"
 #include "sim/shell/ghost_layer.hpp"
 #include "sim/subdivision/limit_refinement.hpp"
 #include "sim/subdivision/loop.hpp"
 #include "sim/subdivision/patch.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -41,6 +45,22 @@ LoopShellDiscretization::LoopShellDiscretization(const TriMesh& mesh, const std:
     : mesh_(mesh), model_(mesh, material, boundary, quadrature), rest_(to_flat(mesh.vertices)) {
   for (int dof = 0; dof < 3 * mesh.num_vertices(); ++dof)
     if (status(dof) == DofStatus::dependent) dependent_.push_back(dof);
+  const ExtendedMesh& ext = model_.extended();
+  std::vector<Eigen::Triplet<double>> dv, dw;
+  for (int t = 0; t < ext.num_real_triangles; ++t) {
+    const PatchEvaluation centre = evaluate_patch(ext.topology, ext.triangles[static_cast<size_t>(t)], 1.0 / 3, 1.0 / 3);
+    for (size_t k = 0; k < centre.vertices.size(); ++k) {
+      const Eigen::Index col = static_cast<Eigen::Index>(k);
+      if (centre.basis(kDv, col) != 0.0) dv.emplace_back(t, centre.vertices[k], centre.basis(kDv, col));
+      if (centre.basis(kDw, col) != 0.0) dw.emplace_back(t, centre.vertices[k], centre.basis(kDw, col));
+    }
+  }
+  centre_dv_.resize(ext.num_real_triangles, ext.num_vertices());
+  centre_dv_.setFromTriplets(dv.begin(), dv.end());
+  centre_dw_.resize(ext.num_real_triangles, ext.num_vertices());
+  centre_dw_.setFromTriplets(dw.begin(), dw.end());
+  rest_dv_ = centre_dv_ * ext.rest;
+  rest_dw_ = centre_dw_ * ext.rest;
 }
 
 void LoopShellDiscretization::make_consistent(Eigen::VectorXd& u) const {
@@ -121,6 +141,28 @@ SurfaceOperator LoopShellDiscretization::display(int levels) const {
   op.triangles = std::move(r.triangles);
   op.levels = r.levels;
   return op;
+}
+
+SurfaceOperator LoopShellDiscretization::flat_display(int levels) const {
+  return midpoint_display(mesh_, levels, model_.extended().num_vertices());
+}
+
+double LoopShellDiscretization::max_membrane_strain(const Eigen::VectorXd& u) const {
+  const Eigen::MatrixX3d net = control_net(rest_ + u);
+  const Eigen::MatrixX3d a1 = centre_dv_ * net, a2 = centre_dw_ * net;
+  double worst = 0.0;
+  for (Eigen::Index e = 0; e < a1.rows(); ++e) {
+    const Eigen::Vector3d c1 = a1.row(e), c2 = a2.row(e), r1 = rest_dv_.row(e), r2 = rest_dw_.row(e);
+    Eigen::Matrix2d g, rest;
+    g << c1.dot(c1), c1.dot(c2), c1.dot(c2), c2.dot(c2);
+    rest << r1.dot(r1), r1.dot(r2), r1.dot(r2), r2.dot(r2);
+    // Eigenvalues of G⁻¹E: those of the symmetric L⁻¹ E L⁻ᵀ with G = L Lᵀ.
+    const Eigen::Matrix2d l_inv = Eigen::Matrix2d(rest.llt().matrixL()).inverse();
+    const Eigen::Matrix2d strain = 0.5 * l_inv * (g - rest) * l_inv.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(0.5 * (strain + strain.transpose()), Eigen::EigenvaluesOnly);
+    worst = std::max(worst, eig.eigenvalues().cwiseAbs().maxCoeff());
+  }
+  return worst;
 }
 
 void LoopShellDiscretization::add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces,

@@ -49,6 +49,15 @@ class LoopShellDiscretization final : public Discretization {
   SurfaceOperator node_points(const std::vector<int>& nodes) const override;
   SurfaceOperator samples(const std::vector<SurfaceSample>& samples) const override;
   SurfaceOperator display(int levels) const override;
+  // The same as display(levels): the drawn surface already is the Loop limit surface.
+  SurfaceOperator loop_limit_display(int levels) const override { return display(levels); }
+  // The control mesh (the prepared mesh's triangles over the nodes, no ghost layer) drawn flat,
+  // midpoint-refined; its columns are the control net's (the ghosts' columns stay empty).
+  SurfaceOperator flat_display(int levels) const override;
+  // Of the limit surface at each element's barycentre: the eigenvalues of G⁻¹E with
+  // E = ½ (g − G), g_αβ = a_α·a_β and G_αβ = A_α·A_β from the current and rest limit tangents
+  // (the strain CorotationalElements::membrane_principal_strains reports).
+  double max_membrane_strain(const Eigen::VectorXd& u) const override;
   void add_point_forces(const SurfaceOperator& op, const Eigen::MatrixX3d& forces, Eigen::VectorXd& f) const override;
   Eigen::SparseMatrix<double, Eigen::RowMajor> point_jacobian(const SurfaceOperator& op) const override;
 
@@ -60,6 +69,10 @@ class LoopShellDiscretization final : public Discretization {
   ShellModel model_;
   Eigen::VectorXd rest_;
   std::vector<int> dependent_;  // dependent DOFs, ascending
+  // The limit tangents ∂x/∂v, ∂x/∂w at each real triangle's barycentre (#triangles × #control
+  // net points) and their rest values (#triangles × 3) [m], for max_membrane_strain.
+  Eigen::SparseMatrix<double, Eigen::RowMajor> centre_dv_, centre_dw_;
+  Eigen::MatrixX3d rest_dv_, rest_dw_;
 };
 
 }  // namespace clothsim

@@ -869,7 +869,7 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   if (j == nullptr) return s;
   r.check_object(*j, "render",
                  {"width", "height", "refine", "color", "back_color", "background", "wireframe", "ground", "camera",
-                  "framing"});
+                  "framing", "surface"});
   if (const Json* v = r.find(*j, "width")) s.width = r.integer_at_least(*v, "render.width", 16);
   if (const Json* v = r.find(*j, "height")) s.height = r.integer_at_least(*v, "render.height", 16);
   if (s.width > 8192 || s.height > 8192) r.fail("render", "images larger than 8192 px are not supported");
@@ -890,6 +890,12 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   colour("background", s.background);
   if (const Json* v = r.find(*j, "wireframe")) s.wireframe = r.boolean(*v, "render.wireframe");
   if (const Json* v = r.find(*j, "ground")) s.ground = r.boolean(*v, "render.ground");
+  if (const Json* v = r.find(*j, "surface")) {
+    const std::string surface = r.choice(*v, "render.surface", {"method", "loop_limit", "flat"}, "surface");
+    s.surface = surface == "loop_limit" ? DrawnSurface::loop_limit
+                : surface == "flat"     ? DrawnSurface::flat
+                                        : DrawnSurface::method;
+  }
   if (const Json* v = r.find(*j, "framing"))
     s.framing = r.choice(*v, "render.framing", {"motion", "sequence"}, "framing") == "sequence" ? Framing::sequence
                                                                                              : Framing::motion;

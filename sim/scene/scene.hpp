@@ -8,6 +8,7 @@
 
 #include "sim/problem/problem.hpp"
 #include "sim/core/log.hpp"
+#include "sim/discretization/drawn_surface.hpp"
 
 #include <Eigen/Core>
 
@@ -41,7 +42,11 @@ enum class Framing {
 // "render": how the application draws the limit surface (plain settings; sim/ does not render).
 struct RenderSettings {
   int width = 960, height = 720;  // image size [px]
-  int refine = 2;                  // Loop steps before the limit masks (0–4)
+  int refine = 2;                  // refinement steps of the drawn surface (0–4)
+  // "render.surface": the method's own surface, the Loop limit surface over the nodes, or the
+  // flat triangles (sim/discretization/drawn_surface.hpp); pictures and OBJ frames at
+  // output.obj_level >= 1 show it, contact keeps the method's own surface.
+  DrawnSurface surface = DrawnSurface::method;
   Eigen::Vector3d color{0.8, 0.1, 0.1};       // front faces, linear RGB in [0, 1]
   Eigen::Vector3d back_color{0.5, 0.1, 0.1};  // back faces
   Eigen::Vector3d background{1, 1, 1};
