@@ -166,6 +166,7 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                      {"solve", totals.solve_ms / 1000.0}}},
                    {"frames", totals.frames},
                    {"max_solver_iterations", totals.max_solver_iterations},
+                   {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)},
                    {"warnings", warnings},
                    {"status", status}};
   if (scene.problem.has_contact())
@@ -232,12 +233,16 @@ class Outputs {
                                     ", t = " + format_double(t) + " s";
         if (scene_.obj_level == 0) {
           write_obj((dir_ / "frames" / file).string(), sim.node_points(), scene_.problem.mesh.triangles, comment);
-        } else {  // the surface drawn at render.refine = obj_level, with its normals
-          if (obj_surface_.num_points() == 0) obj_surface_ = sim.discretization().display(scene_.obj_level);
+        } else {  // the surface drawn at render.refine = obj_level (render.surface), with its normals
+          if (obj_surface_.num_points() == 0)
+            obj_surface_ = sim.discretization().drawn_display(scene_.obj_level, scene_.render.surface);
           Eigen::MatrixX3d p, n;
           obj_surface_.evaluate(sim.discretization().control_net(sim.state().x), p, n);
           write_obj((dir_ / "frames" / file).string(), p, obj_surface_.triangles,
-                    comment + " (refined " + std::to_string(scene_.obj_level) + " times)", &n);
+                    comment + " (refined " + std::to_string(scene_.obj_level) + " times: " +
+                        drawn_surface_description(scene_.problem.method, scene_.render.surface, scene_.obj_level) +
+                        ")",
+                    &n);
         }
       }
       if (images_) {

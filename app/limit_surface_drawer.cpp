@@ -15,10 +15,16 @@ render::Vec3f to_vec3f(const Eigen::Vector3d& v) {
 }
 }  // namespace
 
+nlohmann::ordered_json drawn_surface_json(const std::string& method, const RenderSettings& settings) {
+  return {{"surface", drawn_surface_key(resolve_drawn_surface(method, settings.surface))},
+          {"refine", settings.refine},
+          {"description", drawn_surface_description(method, settings.surface, settings.refine)}};
+}
+
 LimitSurfaceDrawer::LimitSurfaceDrawer(const Discretization& discretization, const RenderSettings& settings, int width,
                                        int height)
     : discretization_(discretization),
-      display_(discretization.display(settings.refine)),
+      display_(discretization.drawn_display(settings.refine, settings.surface)),
       settings_(settings),
       width_(width),
       height_(height) {

@@ -1,6 +1,7 @@
 // The adapter between the simulation and the renderer: turns node positions into plain
-// render::Frame data — the surface refined `render.refine` times (positions and normals from the
-// discretisation's display operator, built once), the control mesh as an optional wireframe, the
+// render::Frame data — the surface chosen by `render.surface` refined `render.refine` times
+// (positions and normals from the discretisation's operator for it, Discretization::drawn_display,
+// built once; by default the method's own surface), the control mesh as an optional wireframe, the
 // scene's colours and a camera (given, or framed once on a box: a whole sequence's bounds, or the
 // box known before a run, see app/frame_images.hpp).
 #pragma once
@@ -10,12 +11,20 @@
 #include "sim/discretization/discretization.hpp"
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <string>
 
 namespace clothsim {
 
+// What a picture shows, for summary.json and result.json: {"surface": "loop_limit" or "flat"
+// (render.surface resolved for the method), "refine": k, "description": "Loop limit surface
+// refined 2x"} (sim/discretization/drawn_surface.hpp).
+nlohmann::ordered_json drawn_surface_json(const std::string& method, const RenderSettings& settings);
+
 // One frame's geometry, kept in single precision until it is drawn.
 struct SurfaceSnapshot {
-  std::vector<float> positions;  // limit surface, 3 per fine vertex [m]
+  std::vector<float> positions;  // the drawn surface, 3 per fine vertex [m]
   std::vector<float> normals;    // unit normals, 3 per fine vertex
   std::vector<float> control;    // control mesh vertices (wireframe), 3 per vertex [m]
   std::vector<float> obstacles;  // the obstacles' mesh vertices at the frame's time, 3 per vertex [m]

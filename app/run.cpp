@@ -55,7 +55,8 @@ std::string result_json(const Scene& scene, const StaticResult& result) {
   OrderedJson out = {{"probes", probes},
                      {"vertices", scene.problem.mesh.num_vertices()},
                      {"dofs", result.dofs},
-                     {"seconds", {{"assemble", result.assemble_seconds}, {"solve", result.solve_seconds}}}};
+                     {"seconds", {{"assemble", result.assemble_seconds}, {"solve", result.solve_seconds}}},
+                     {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)}};
   return out.dump(2) + "\n";
 }
 
