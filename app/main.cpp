@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <iostream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -42,25 +43,54 @@ int render_command(int argc, char** argv) {
   return clothsim::render_saved_frames(dir, width, height);
 }
 
-// `clothsim study convergence|stability [--out DIR] [--quick] [--no-plot]`.
+// `clothsim study convergence|stability|folds [--out DIR] [--quick] [--no-plot]`, and for `folds`
+// the options that rerun it differently (--meshes, --seeds, --methods, --cases, --preset,
+// --amplitude, --dt, --end).
 int study_command(int argc, char** argv) {
-  CLI::App app{"clothsim study: the reports of error against run time (convergence) and of numerical\n"
-               "stability on stiff and extreme cases (stability); see README.md, \"Studies\".",
+  CLI::App app{"clothsim study: the reports of error against run time (convergence), of numerical\n"
+               "stability on stiff and extreme cases (stability) and of fold counts against resolution\n"
+               "(folds); see README.md, \"Studies\".",
                "clothsim study"};
   std::string which;
   clothsim::StudyOptions options;
   std::string out = options.out_root.string();
   bool no_plot = false;
-  app.add_option("study", which, "convergence or stability")
+  app.add_option("study", which, "convergence, stability or folds")
       ->required()
-      ->check(CLI::IsMember({"convergence", "stability"}))
+      ->check(CLI::IsMember({"convergence", "stability", "folds"}))
       ->type_name("NAME");
   app.add_option("--out", out, "Output root; the report goes to DIR/study_<NAME>/")->type_name("DIR")->capture_default_str();
   app.add_flag("--quick", options.quick, "Run a small subset of the cases (seconds; used by the tests)");
   app.add_flag("--no-plot", no_plot, "Write the data but no PNG (no python3-matplotlib needed)");
+  // `study folds` only.
+  clothsim::FoldStudyArgs folds;
+  double amplitude = 0.0, dt = 0.0, end = 0.0;
+  std::vector<CLI::Option*> fold_options = {
+      app.add_option("--meshes", folds.meshes, "folds: cylinder meshes, e.g. 26x19,38x27 (segments x rings)")
+          ->type_name("SxR,..."),
+      app.add_option("--seeds", folds.seeds, "folds: imperfection seeds, e.g. 1,2,3")->type_name("N,..."),
+      app.add_option("--methods", folds.methods, "folds: methods, e.g. loop_kl,linear_fe,mass_spring")
+          ->type_name("NAME,..."),
+      app.add_option("--cases", folds.cases, "folds: twist, compress or both (comma-separated)")->type_name("NAME,..."),
+      app.add_option("--preset", folds.preset, "folds: material preset (default cotton)")->type_name("NAME"),
+      app.add_option("--amplitude", amplitude, "folds: imperfection amplitude [m] (default 0.5 t_eff)")->type_name("M"),
+      app.add_option("--dt", dt, "folds: time step [s] (default 0.005)")->type_name("S"),
+      app.add_option("--end", end, "folds: simulated time [s] (default 1, the end of the motion)")->type_name("S")};
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
   options.out_root = out;
   options.plot = !no_plot;
+  if (which != "folds")
+    for (const CLI::Option* o : fold_options)
+      if (o->count() > 0) {
+        std::cerr << "clothsim: error: " << o->get_name() << " applies to `clothsim study folds` only\n";
+        return 1;
+      }
+  if (which == "folds") {
+    if (fold_options[5]->count() > 0) folds.amplitude = amplitude;
+    if (fold_options[6]->count() > 0) folds.dt = dt;
+    if (fold_options[7]->count() > 0) folds.end = end;
+    return clothsim::run_fold_study_report(options, folds);
+  }
   return which == "convergence" ? clothsim::run_convergence_study(options) : clothsim::run_stability_study(options);
 }
 
@@ -75,7 +105,7 @@ int main(int argc, char** argv) {
       "its results to DIR/<scene name>/: result.json and limit.obj for a static scene;\n"
       "probes.csv, stats.csv, summary.json, frame_NNNN.png and (with output.obj) frames/ for a\n"
       "dynamic one. `clothsim render DIR` draws a run's saved frames/mesh_*.obj again;\n"
-      "`clothsim study convergence|stability` writes the reports of README.md, \"Studies\".",
+      "`clothsim study convergence|stability|folds` writes the reports of README.md, \"Studies\".",
       "clothsim"};
   std::string scene;
   std::string out = "out";

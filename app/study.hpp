@@ -1,4 +1,4 @@
-// `clothsim study convergence|stability`: the two reports of issue 5. Each runs its cases, writes
+// `clothsim study convergence|stability|folds`: the reports of issue 5 and the fold study. Each runs its cases, writes
 // DIR/study_<name>/ (CSV data, a Markdown table where there is one, and a PNG plot drawn by
 // scripts/plot_<name>.py with Debian's python3-matplotlib) and prints where it wrote.
 // The folder is published atomically: it is built under a temporary name and renamed at the end,
@@ -6,6 +6,8 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <string>
 
 namespace clothsim {
 
@@ -18,5 +20,20 @@ struct StudyOptions {
 // Return the process exit code: 0 on success, 1 on error (message on stderr, "clothsim: error: ...").
 int run_convergence_study(const StudyOptions& options);
 int run_stability_study(const StudyOptions& options);
+
+// `clothsim study folds` (app/study_folds.cpp, docs/fold_study.md): the options that rerun it
+// differently. Empty strings / unset values keep the plan's defaults (the full plan, or the quick
+// one with --quick); the lists are parsed by sim/study/fold_study.hpp's parse_fold_*.
+struct FoldStudyArgs {
+  std::string meshes;   // "26x19,38x27,..." (segments x rings)
+  std::string seeds;    // "1,2,3"
+  std::string methods;  // "loop_kl,linear_fe,mass_spring"
+  std::string cases;    // "twist,compress"
+  std::string preset;   // material preset, e.g. "cotton"
+  std::optional<double> amplitude;  // [m] imperfection amplitude
+  std::optional<double> dt;         // [s]
+  std::optional<double> end;        // [s]
+};
+int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args);
 
 }  // namespace clothsim
