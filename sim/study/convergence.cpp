@@ -4,7 +4,6 @@
 #include "sim/scene/scene.hpp"
 #include "sim/shell/dof_map.hpp"
 #include "sim/study/report_format.hpp"
-#include "sim/subdivision/loop.hpp"
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -46,26 +45,16 @@ MethodRun solve_static_run(const Problem& problem, const std::vector<SurfaceSamp
   return run;
 }
 
-// The surface whose folds are counted, for node positions x [m]: a smooth drawing at
-// kFoldSurfaceLevels. loop_kl: its drawn surface (the display operator, limit points of the
-// refined control net). A flat method's drawn surface is its facets — a 14-gon's corners stand
-// 1.3 mm off the circle, above the fold counter's 1 mm prominence — so its nodes are drawn through
-// the same subdivision scheme instead: kFoldSurfaceLevels Loop steps of the node mesh (crease
-// rules at the rims, sim/subdivision/loop.hpp).
+// The surface whose folds are counted, for node positions x [m]: the Loop limit surface over the
+// nodes at kFoldSurfaceLevels (Discretization::loop_limit_display) for every method — loop_kl's
+// own drawn surface; for a flat method the smooth surface its nodes span, since its own drawing is
+// its facets, whose corners on a coarse sleeve (a 14-gon's stand 1.3 mm off the circle) exceed
+// the fold counter's 1 mm prominence.
 void fold_surface(const Discretization& d, const Eigen::VectorXd& x, Eigen::MatrixX3d& points,
                   std::vector<Triangle>& triangles) {
-  if (d.method() == "loop_kl") {
-    const SurfaceOperator drawn = d.display(kFoldSurfaceLevels);
-    points = d.surface_positions(drawn, x);
-    triangles = drawn.triangles;
-    return;
-  }
-  TriMesh mesh;
-  mesh.vertices = d.control_net(x);
-  mesh.triangles = d.mesh().triangles;
-  for (int level = 0; level < kFoldSurfaceLevels; ++level) mesh = loop_subdivide(mesh);
-  points = std::move(mesh.vertices);
-  triangles = std::move(mesh.triangles);
+  const SurfaceOperator drawn = d.loop_limit_display(kFoldSurfaceLevels);
+  points = d.surface_positions(drawn, x);
+  triangles = drawn.triangles;
 }
 
 // A dynamic run of `problem` as given (its method and quadrature set by the caller) to the last

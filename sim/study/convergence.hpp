@@ -72,10 +72,10 @@ struct MethodRun {
   std::vector<Triangle> final_surface_triangles;
 };
 
-// Refinement levels of the surface whose folds are counted, the same for every method: loop_kl's
-// display operator (Discretization::display) at this level; a flat method's nodes through this
-// many Loop subdivision steps (its own display operator keeps the facets, whose corners on a
-// coarse sleeve would count as folds). docs/convergence.md, "Post-buckling measures".
+// Refinement levels of the surface whose folds are counted, the same for every method: the Loop
+// limit surface over the nodes (Discretization::loop_limit_display: loop_kl's drawn surface; for
+// a flat method the smooth surface its nodes span, since its own facets' corners on a coarse
+// sleeve would count as folds). docs/convergence.md, "Post-buckling measures".
 inline constexpr int kFoldSurfaceLevels = 2;
 
 // A named way to discretise and solve a case. `points` are parameter points of the problem's
