@@ -4,9 +4,11 @@
 //
 // A run is a shipped sleeve scene (scenes/sleeve_twist.json or scenes/sleeve_compress.json) with
 // its mesh (segments × rings of the cylinder primitive), "method", material preset, time step and
-// "imperfection" replaced and self-collision switched off, simulated to the scene's end time. At
-// the end the drawn surface (Discretization::display(2): two refinement steps of the method)
-// is handed to count_sleeve_folds (sim/study/fold_count.hpp, default options): the median over 9
+// "imperfection" replaced, self-collision switched off and PCG preconditioned by a Cholesky factor
+// ("preconditioner": "cholesky"), simulated to the plan's end time (default 1 s, the end of the
+// scenes' motion). At the end the drawn surface (Discretization::display(2): two refinement steps of the method —
+// Loop subdivision for loop_kl, midpoint refinement of the flat triangles for the others) is
+// handed to count_sleeve_folds (sim/study/fold_count.hpp, default options): the median over 9
 // heights of the r(θ) peak count (circumferential) and the median over 16 half-planes of the r(s)
 // peak count (axial).
 //
