@@ -1,10 +1,12 @@
 // Command-line entry point: `clothsim SCENE.json [--out DIR] [--end T]`. Argument parsing (CLI11)
 // lives in this file only; the work is done by run_scene_file (app/run.hpp).
+#include "app/figures.hpp"
 #include "app/run.hpp"
 #include "app/study.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 #include <string>
@@ -94,11 +96,47 @@ int study_command(int argc, char** argv) {
   return which == "convergence" ? clothsim::run_convergence_study(options) : clothsim::run_stability_study(options);
 }
 
+// `clothsim figures [N ...] [--out DIR] [--size WxH] [--quick] [--rerun]`.
+int figures_command(int argc, char** argv) {
+  CLI::App app{"clothsim figures: reproduces the paper's Figs. 1 and 7-11 from shipped scenes: runs the\n"
+               "scenes (or reuses completed runs of the same scenes) and writes DIR/figures/figN.png\n"
+               "(labelled panels), figN.md and figures.md (which scene and settings made each panel,\n"
+               "fold counts); see docs/figures.md.",
+               "clothsim figures"};
+  clothsim::FiguresOptions options;
+  std::string out = options.out_root.string(), size;
+  app.add_option("figures", options.figures, "Figure numbers (1 7 8 9 10 11); none: all")->type_name("N ...");
+  app.add_option("--out", out, "Output root; the figures go to DIR/figures/")->type_name("DIR")->capture_default_str();
+  app.add_option("--size", size, "Panel size, default 480x360")->type_name("WxH");
+  app.add_flag("--quick", options.quick, "Runs of 2 frames only (seconds; the panels do not show the figure)");
+  app.add_flag("--rerun", options.rerun, "Run every scene again, even if a completed run of it exists");
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
+  options.out_root = out;
+  if (!size.empty()) {
+    int width = 0, height = 0, used = 0;
+    if (std::sscanf(size.c_str(), "%dx%d%n", &width, &height, &used) != 2 || used != static_cast<int>(size.size()) ||
+        width < 16 || height < 16 || width > 4096 || height > 4096) {
+      std::cerr << "clothsim: error: --size: expected WxH with 16 <= W, H <= 4096 (got \"" << size << "\")\n";
+      return 1;
+    }
+    options.width = width;
+    options.height = height;
+  }
+  for (int n : options.figures)
+    if (std::find(clothsim::figure_numbers().begin(), clothsim::figure_numbers().end(), n) ==
+        clothsim::figure_numbers().end()) {
+      std::cerr << "clothsim: error: figures: no figure " << n << " (allowed: 1 7 8 9 10 11)\n";
+      return 1;
+    }
+  return clothsim::run_figures(options);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "render") return render_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "study") return study_command(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "figures") return figures_command(argc, argv);
   CLI::App app{
       "clothsim: Kirchhoff-Love thin-shell cloth simulator on Loop-subdivision surfaces.\n"
       "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes\n"

@@ -1,0 +1,428 @@
+// `clothsim figures`: see app/figures.hpp and docs/figures.md.
+#include "app/figures.hpp"
+
+#include "app/output_folders.hpp"
+#include "app/plotting.hpp"
+#include "app/run.hpp"
+#include "sim/mesh/obj_io.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/study/fold_count.hpp"
+#include "sim/study/report_format.hpp"
+
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#ifndef CLOTHSIM_SOURCE_DIR
+#error "CLOTHSIM_SOURCE_DIR must be defined (app/CMakeLists.txt)"
+#endif
+
+namespace clothsim {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+// A shipped scene, with `patch` (a JSON merge patch, RFC 7386) applied and the name set to `id`.
+struct RunSpec {
+  std::string id;     // also the run's folder name
+  std::string scene;  // file name in scenes/
+  Json patch = Json::object();
+  bool sleeve = true;  // count folds about the y axis on its panels
+};
+
+struct PanelSpec {
+  std::string run;  // RunSpec::id
+  double time = 0.0;  // [s]
+};
+
+struct FigureSpec {
+  int number = 0;
+  std::string title;    // above the montage
+  std::string caption;  // the paper's caption in our words (figN.md)
+  int columns = 3;
+  std::vector<PanelSpec> panels;
+};
+
+const Json kBlue = Json::parse(R"({"color": [0.12, 0.25, 0.8], "back_color": [0.08, 0.12, 0.45]})");
+
+std::vector<RunSpec> run_specs() {
+  std::vector<RunSpec> runs;
+  runs.push_back({"compress_denim_loop_kl_2232", "sleeve_compress_denim.json", Json::object(), true});
+  Json linear = {{"method", "linear_fe"}, {"render", kBlue}};
+  runs.push_back({"compress_denim_linear_fe_2232", "sleeve_compress_denim.json", linear, true});
+  runs.push_back({"compress_denim_loop_kl_5856", "sleeve_compress_denim_5856.json", Json::object(), true});
+  runs.push_back({"compress_denim_linear_fe_5856", "sleeve_compress_denim_5856.json", linear, true});
+  runs.push_back({"catenary_black_denim", "sleeve_catenary.json", Json::object(), false});
+  runs.push_back({"catenary_pink_ribbon_brown", "sleeve_catenary.json",
+                  Json{{"material", {{"preset", "pink_ribbon_brown"}}}}, false});
+  runs.push_back({"catenary_gray_interlock", "sleeve_catenary.json",
+                  Json{{"material", {{"preset", "gray_interlock"}}}}, false});
+  runs.push_back({"catenary_mesh", "sleeve_catenary.json",
+                  Json{{"render", {{"wireframe", true}, {"color", {0.85, 0.85, 0.85}}, {"back_color", {0.6, 0.6, 0.6}}}}},
+                  false});
+  runs.push_back({"twist_cotton_494", "sleeve_twist.json", Json::object(), true});
+  runs.push_back({"fig8_thin", "fig8_thin.json", Json::object(), true});
+  runs.push_back({"fig8_thick", "fig8_thick.json", Json::object(), true});
+  runs.push_back({"fig8_thick_stiff", "fig8_thick_stiff.json", Json::object(), true});
+  runs.push_back({"metal_compress", "metal_compress.json", Json::object(), true});
+  return runs;
+}
+
+std::vector<FigureSpec> figure_specs() {
+  std::vector<FigureSpec> figures;
+  figures.push_back({1,
+                     "Fig. 1: compressed sleeve, subdivision shell (red) vs linear FE with hinge bending (blue)",
+                     "Buckling of a sleeve under axial compression. Red: the subdivision shell (loop_kl); blue: "
+                     "the standard approach, linear triangles with hinge bending (linear_fe), on the same meshes "
+                     "of about 2232 and 5856 vertices. The paper shows the red result reproducing the "
+                     "diamond-shaped buckling pattern and the blue one changing substantially with the mesh.",
+                     4,
+                     {{"compress_denim_loop_kl_2232", 1.5},
+                      {"compress_denim_linear_fe_2232", 1.5},
+                      {"compress_denim_loop_kl_5856", 1.5},
+                      {"compress_denim_linear_fe_5856", 1.5}}});
+  figures.push_back({7,
+                     "Fig. 7: folds of a sleeve under gravity, torsion and compression",
+                     "Kinds of folds on a sleeve. Left: catenary-shaped folds under gravity. Middle: diagonal "
+                     "folds from twisting one end. Right: buckling under axial compression (no gravity).",
+                     3,
+                     {{"catenary_black_denim", 2.0}, {"twist_cotton_494", 1.5}, {"compress_denim_loop_kl_2232", 1.5}}});
+  figures.push_back({8,
+                     "Fig. 8: twisted sleeves of three materials on one 1500-triangle mesh (front view)",
+                     "Twisted sleeves of different materials on the same mesh of 1500 triangles. Left: a thin "
+                     "material; middle: ten times thicker; right: as the middle with ten times the stretch "
+                     "resistance. The number of folds follows the material although the mesh is the same.",
+                     3,
+                     {{"fig8_thin", 1.5}, {"fig8_thick", 1.5}, {"fig8_thick_stiff", 1.5}}});
+  figures.push_back({9,
+                     "Fig. 9: a sleeve under increasing torsion",
+                     "A sleeve twisted further and further: fine wrinkles form first and merge into larger folds.",
+                     5,
+                     {{"fig8_thin", 0.1}, {"fig8_thin", 0.25}, {"fig8_thin", 0.5}, {"fig8_thin", 1.0}, {"fig8_thin", 1.5}}});
+  figures.push_back({10,
+                     "Fig. 10: sleeves of different materials under gravity, and the mesh",
+                     "Sleeves under gravity with different material parameters; right: the mesh used (494 "
+                     "vertices, 936 triangles).",
+                     4,
+                     {{"catenary_gray_interlock", 2.0},
+                      {"catenary_pink_ribbon_brown", 2.0},
+                      {"catenary_black_denim", 2.0},
+                      {"catenary_mesh", 0.0}}});
+  figures.push_back({11,
+                     "Fig. 11: axial compression of a metal-like sleeve (with self-collision)",
+                     "A sequence from the axial compression of a sleeve of a metal-like material (E t = 1e5 N/m, "
+                     "nu = 0.05, 1 mm thick).",
+                     5,
+                     {{"metal_compress", 0.1}, {"metal_compress", 0.3}, {"metal_compress", 0.6},
+                      {"metal_compress", 1.0}, {"metal_compress", 1.5}}});
+  return figures;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot read the file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Writes `text` to `path` through a temporary sibling and a rename (whole or absent).
+void write_whole(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  write_text_file(tmp, text);
+  fs::rename(tmp, path);
+}
+
+std::string fixed(double v, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", digits, v);
+  return buffer;
+}
+
+// What a run is: its merged scene and the facts the labels need.
+struct PreparedRun {
+  RunSpec spec;
+  std::string scene_text;  // the merged scene (what is written to scenes/<id>.json)
+  std::string method, material, surface;
+  int vertices = 0;
+  double fps = 30.0, end = 0.0, scene_end = 0.0;
+  double wall_seconds = 0.0;  // of the run (from its summary.json)
+  bool reused = false;
+};
+
+PreparedRun prepare(const RunSpec& spec, const fs::path& scenes_dir, double needed_end) {
+  PreparedRun run;
+  run.spec = spec;
+  const fs::path source = scenes_dir / spec.scene;
+  Json scene;
+  try {
+    scene = Json::parse(read_text(source));
+  } catch (const Json::exception& e) {
+    throw std::runtime_error(source.string() + ": " + e.what());
+  }
+  scene.merge_patch(spec.patch);
+  scene["name"] = spec.id;
+  if (spec.sleeve) scene["output"] = Json{{"obj", true}, {"obj_level", 1}};
+  run.method = scene.value("method", std::string("loop_kl"));
+  run.material = scene.contains("material") && scene["material"].contains("preset")
+                     ? scene["material"]["preset"].get<std::string>()
+                     : std::string("custom material");
+  const std::string surface = scene.contains("render") ? scene["render"].value("surface", std::string("method"))
+                                                       : std::string("method");
+  run.surface = run.method == "loop_kl" ? "limit surface"
+                : surface == "loop_limit" ? "Loop limit of the flat mesh"
+                                          : "flat mesh";
+  run.scene_text = scene.dump(2) + "\n";
+  const Scene loaded = load_scene_text(run.scene_text, source, {});
+  run.vertices = loaded.problem.mesh.num_vertices();
+  run.fps = loaded.problem.time.output_fps;
+  run.scene_end = loaded.problem.time.end;
+  if (needed_end > run.scene_end + 1e-12)
+    throw std::runtime_error("figure run " + spec.id + " needs t = " + fixed(needed_end, 3) + " s but " +
+                             source.string() + " ends at " + fixed(run.scene_end, 3) + " s");
+  run.end = needed_end;
+  return run;
+}
+
+// The stamp that says which scene and options made a run folder.
+std::string stamp_of(const PreparedRun& run, const FiguresOptions& options) {
+  return run.scene_text + "# end " + fixed(run.end, 6) + " size " + std::to_string(options.width) + "x" +
+         std::to_string(options.height) + (options.quick ? " quick" : "") + "\n";
+}
+
+// The run's summary.json, if it says the run completed.
+std::optional<Json> completed_summary(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::exists(dir / "summary.json", ec)) return std::nullopt;
+  try {
+    Json summary = Json::parse(read_text(dir / "summary.json"));
+    if (summary.value("status", std::string()) == "completed") return summary;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+void execute(PreparedRun& run, const fs::path& root, const FiguresOptions& options) {
+  const fs::path scene_file = root / "scenes" / (run.spec.id + ".json");
+  const fs::path stamp_file = root / "runs" / (run.spec.id + ".stamp");
+  const fs::path dir = root / "runs" / run.spec.id;
+  const std::string stamp = stamp_of(run, options);
+  std::error_code ec;
+  if (!options.rerun && fs::exists(stamp_file, ec) && read_text(stamp_file) == stamp) {
+    if (const auto summary = completed_summary(dir)) {
+      run.reused = true;
+      run.wall_seconds = summary->value("wall_seconds", 0.0);
+      std::cerr << "clothsim: figures: run " << run.spec.id << ": reusing " << dir.string() << '\n';
+      return;
+    }
+  }
+  write_whole(scene_file, run.scene_text);
+  fs::remove(stamp_file, ec);
+  RunOptions run_options;
+  run_options.width = options.width;
+  run_options.height = options.height;
+  if (options.quick)
+    run_options.frames = 2;
+  else if (run.end <= 0.0)
+    run_options.frames = 1;
+  else
+    run_options.end = run.end;
+  std::cerr << "clothsim: figures: run " << run.spec.id << " (" << run.method << ", " << run.vertices
+            << " vertices, " << run.material << ")\n";
+  if (run_scene_file(scene_file, root / "runs", run_options) != 0)
+    throw std::runtime_error("figure run " + run.spec.id + " failed (scene " + scene_file.string() + ")");
+  const auto summary = completed_summary(dir);
+  if (!summary) throw std::runtime_error("figure run " + run.spec.id + ": " + dir.string() + " did not complete");
+  run.wall_seconds = summary->value("wall_seconds", 0.0);
+  write_whole(stamp_file, stamp);
+}
+
+// The frame a panel shows: index round(t · fps), clamped to the frames a quick run has.
+int frame_index(const PreparedRun& run, double time, bool quick) {
+  const int k = static_cast<int>(std::lround(time * run.fps));
+  return quick ? std::min(k, 1) : k;
+}
+
+std::string frame_name(const char* prefix, int k, const char* suffix) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%s%04d%s", prefix, k, suffix);
+  return buffer;
+}
+
+struct PanelResult {
+  fs::path image;
+  std::string label;
+  double time = 0.0;
+  std::optional<SleeveFolds> folds;
+  std::string note;
+};
+
+PanelResult make_panel(const PreparedRun& run, const PanelSpec& panel, const fs::path& root, bool quick) {
+  PanelResult result;
+  const int k = frame_index(run, panel.time, quick);
+  result.time = k / run.fps;
+  const fs::path dir = root / "runs" / run.spec.id;
+  result.image = dir / frame_name("frame_", k, ".png");
+  std::error_code ec;
+  if (!fs::exists(result.image, ec))
+    throw std::runtime_error("figure run " + run.spec.id + ": " + result.image.string() + " is missing");
+  if (run.spec.sleeve) {
+    const fs::path obj = dir / "frames" / frame_name("mesh_", k, ".obj");
+    try {
+      const TriMesh mesh = read_obj(obj.string());
+      result.folds = count_sleeve_folds(mesh.vertices, mesh.triangles, FoldAxis{});
+    } catch (const std::exception& e) {
+      result.note = std::string("folds not counted: ") + e.what();
+    }
+  }
+  std::ostringstream label;
+  label << run.method << " (" << run.surface << "), " << run.vertices << " vertices\n"
+        << run.material << ", t = " << fixed(result.time, 2) << " s";
+  if (result.folds) {
+    const auto around = result.folds->circumferential_median;
+    const auto along = result.folds->axial.median_count;
+    label << "\nfolds: " << (around ? fixed(*around, 1) : std::string("-")) << " around, "
+          << (along ? fixed(*along, 1) : std::string("-")) << " along";
+  }
+  result.label = label.str();
+  return result;
+}
+
+std::string figure_markdown(const FigureSpec& figure, const std::vector<PanelResult>& panels,
+                            const std::vector<const PreparedRun*>& runs, const FiguresOptions& options) {
+  std::ostringstream md;
+  md << "## Fig. " << figure.number << "\n\n![" << figure.title << "](fig" << figure.number << ".png)\n\n"
+     << "The paper: " << figure.caption << "\n\n"
+     << "| panel | run (scene file) | method (drawn surface) | vertices | material | t [s] | frame | "
+        "folds around (median) | folds along (median) | run wall time [s] |\n"
+     << "|---|---|---|--:|---|--:|---|--:|--:|--:|\n";
+  for (size_t i = 0; i < panels.size(); ++i) {
+    const PreparedRun& run = *runs[i];
+    const PanelResult& p = panels[i];
+    std::string around = "–", along = "–";
+    if (p.folds && p.folds->circumferential_median) around = fixed(*p.folds->circumferential_median, 1);
+    if (p.folds && p.folds->axial.median_count) along = fixed(*p.folds->axial.median_count, 1);
+    md << "| " << i + 1 << " | `" << run.spec.id << "` (`scenes/" << run.spec.scene << "`"
+       << (run.spec.patch.empty() ? std::string() : ", with `" + run.spec.patch.dump() + "`") << ") | " << run.method
+       << " (" << run.surface << ") | " << run.vertices << " | " << run.material << " | " << fixed(p.time, 3) << " | `"
+       << p.image.filename().string() << "` | " << around << " | " << along << " | " << fixed(run.wall_seconds, 1)
+       << (run.reused ? " (earlier run)" : "") << " |\n";
+  }
+  md << "\nEach run's scene as run is `scenes/<run>.json` next to this file; its outputs are in `runs/<run>/`. "
+     << "Panels " << options.width << " × " << options.height
+     << " px. Folds are counted on the run's OBJ frame (the drawn surface refined once) with the "
+        "mesh-independent counter of docs/fold_count.md: sections at 9 heights over 20–80 % of the "
+        "sleeve (around) and 16 half-planes through the axis (along), prominence ≥ 2 % of the mean "
+        "radius.";
+  if (options.quick) md << " **Quick mode: every run is 2 frames long; the panels do not show the figure.**";
+  for (const PanelResult& p : panels)
+    if (!p.note.empty()) md << "\n\nNote: " << p.note;
+  md << "\n";
+  return md.str();
+}
+
+// Lays out the panels with scripts/montage.py into `png`.
+void montage(const FigureSpec& figure, const std::vector<PanelResult>& panels, const fs::path& png) {
+  Json layout = {{"title", figure.title}, {"columns", figure.columns}, {"panels", Json::array()}};
+  for (const PanelResult& p : panels) layout["panels"].push_back({{"image", p.image.string()}, {"label", p.label}});
+  const std::string suffix = ".tmp-" + std::to_string(::getpid());
+  const fs::path layout_file = png.parent_path() / ("." + png.stem().string() + ".layout" + suffix + ".json");
+  const fs::path tmp_png = png.parent_path() / ("." + png.stem().string() + suffix + ".png");
+  write_text_file(layout_file, layout.dump(2));
+  const std::string error = run_plot_script("montage.py", {layout_file.string(), tmp_png.string()});
+  std::error_code ec;
+  fs::remove(layout_file, ec);
+  if (!error.empty()) {
+    fs::remove(tmp_png, ec);
+    throw std::runtime_error(png.string() + ": " + error);
+  }
+  fs::rename(tmp_png, png);
+}
+
+}  // namespace
+
+const std::vector<int>& figure_numbers() {
+  static const std::vector<int> numbers = [] {
+    std::vector<int> n;
+    for (const FigureSpec& f : figure_specs()) n.push_back(f.number);
+    return n;
+  }();
+  return numbers;
+}
+
+int run_figures(const FiguresOptions& options) {
+  try {
+    const auto start = std::chrono::steady_clock::now();
+    const std::vector<FigureSpec> all = figure_specs();
+    std::vector<FigureSpec> wanted;
+    for (const FigureSpec& f : all)
+      if (options.figures.empty() ||
+          std::find(options.figures.begin(), options.figures.end(), f.number) != options.figures.end())
+        wanted.push_back(f);
+    for (int n : options.figures)
+      if (std::find(figure_numbers().begin(), figure_numbers().end(), n) == figure_numbers().end())
+        throw std::invalid_argument("no figure " + std::to_string(n) + " (allowed: 1 7 8 9 10 11)");
+
+    // The runs the figures need, each to the latest time one of its panels shows.
+    std::map<std::string, double> needed;
+    for (const FigureSpec& f : wanted)
+      for (const PanelSpec& p : f.panels) needed[p.run] = std::max(needed[p.run], p.time);
+    const fs::path scenes_dir = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
+    std::map<std::string, PreparedRun> runs;
+    for (const RunSpec& spec : run_specs())
+      if (needed.count(spec.id)) runs.emplace(spec.id, prepare(spec, scenes_dir, needed[spec.id]));
+
+    const fs::path root = options.out_root / "figures";
+    fs::create_directories(root / "scenes");
+    fs::create_directories(root / "runs");
+    for (auto& [id, run] : runs) execute(run, root, options);
+
+    for (const FigureSpec& figure : wanted) {
+      std::vector<PanelResult> panels;
+      std::vector<const PreparedRun*> panel_runs;
+      for (const PanelSpec& p : figure.panels) {
+        const PreparedRun& run = runs.at(p.run);
+        panels.push_back(make_panel(run, p, root, options.quick));
+        panel_runs.push_back(&run);
+      }
+      const fs::path png = root / ("fig" + std::to_string(figure.number) + ".png");
+      montage(figure, panels, png);
+      write_whole(root / ("fig" + std::to_string(figure.number) + ".md"),
+                  figure_markdown(figure, panels, panel_runs, options));
+      std::cout << "figures: wrote " << png.string() << '\n';
+    }
+    // figures.md: every figN.md present, in order.
+    std::string index =
+        "# Figures of Thomaszewski, Wacker & Straßer (SCA 2006), reproduced by `clothsim figures`\n\n"
+        "Each section says which shipped scene and settings made each panel and what was measured on it "
+        "(docs/figures.md explains the set-ups).\n\n";
+    for (int n : figure_numbers()) {
+      const fs::path md = root / ("fig" + std::to_string(n) + ".md");
+      std::error_code ec;
+      if (fs::exists(md, ec)) index += read_text(md) + "\n";
+    }
+    write_whole(root / "figures.md", index);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "figures: " << wanted.size() << " figure(s) in " << fixed(seconds, 1) << " s; wrote "
+              << (root / "figures.md").string() << '\n';
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "clothsim: error: figures: " << e.what() << '\n';
+    return 1;
+  }
+}
+
+}  // namespace clothsim
