@@ -143,7 +143,8 @@ int main(int argc, char** argv) {
       "its results to DIR/<scene name>/: result.json and limit.obj for a static scene;\n"
       "probes.csv, stats.csv, summary.json, frame_NNNN.png and (with output.obj) frames/ for a\n"
       "dynamic one. `clothsim render DIR` draws a run's saved frames/mesh_*.obj again;\n"
-      "`clothsim study convergence|stability|folds` writes the reports of README.md, \"Studies\".",
+      "`clothsim study convergence|stability|folds` writes the reports of README.md, \"Studies\";\n"
+      "`clothsim figures [N ...]` reproduces the paper's Figs. 1 and 7-11 (docs/figures.md).",
       "clothsim"};
   std::string scene;
   std::string out = "out";
