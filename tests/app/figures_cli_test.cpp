@@ -22,12 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using clothsim::testing::read_file_bytes;
+using clothsim::testing::run_shell;
 using clothsim::testing::shell_quote;
-
-int run_shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-}
 
 // Width and height from a PNG's IHDR chunk (bytes 16–23, big-endian).
 std::pair<uint32_t, uint32_t> png_size(const std::string& bytes) {
@@ -43,9 +39,7 @@ std::pair<uint32_t, uint32_t> png_size(const std::string& bytes) {
 class FiguresCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "clothsim_figures_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
+    dir_ = clothsim::testing::make_temp_dir("clothsim_figures_cli_");
   }
   void TearDown() override {
     std::error_code ec;
@@ -64,7 +58,7 @@ class FiguresCli : public ::testing::Test {
 };
 
 TEST_F(FiguresCli, QuickFigure10IsPublishedLabelledAndReproducible) {
-  if (run_shell("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0)
+  if (!clothsim::testing::has_matplotlib())
     GTEST_SKIP() << "/usr/bin/python3 has no matplotlib (scripts/install_deps.sh installs python3-matplotlib)";
   const fs::path out = dir_ / "out";
   ASSERT_EQ(figures("10 --quick --size 64x48 --out " + shell_quote(out.string())), 0) << err_;

@@ -26,12 +26,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using clothsim::testing::read_file_bytes;
+using clothsim::testing::run_shell;
 using clothsim::testing::shell_quote;
-
-int run_shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-}
 
 std::vector<std::string> split(const std::string& text, char separator) {
   std::vector<std::string> parts;
@@ -63,9 +59,7 @@ std::vector<std::map<std::string, std::string>> csv_rows(const std::string& text
 class StudyFoldsCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "clothsim_folds_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
+    dir_ = clothsim::testing::make_temp_dir("clothsim_folds_cli_");
   }
   void TearDown() override {
     std::error_code ec;
@@ -151,7 +145,7 @@ TEST_F(StudyFoldsCli, QuickWithoutPlotWritesOneFiniteRowPerRun) {
   EXPECT_NE(table.find("| compress | mass_spring | 18×13 | 234 |"), std::string::npos) << table;
 
   // The plot from this CSV (skipped without Debian's python3-matplotlib).
-  if (run_shell("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) GTEST_SKIP() << "no matplotlib";
+  if (!clothsim::testing::has_matplotlib()) GTEST_SKIP() << "no matplotlib";
   const fs::path png = dir_ / "folds.png";
   ASSERT_EQ(run_shell("/usr/bin/python3 " + shell_quote(std::string(CLOTHSIM_SOURCE_DIR) + "/scripts/plot_folds.py") +
                       " " + shell_quote((report / "results.csv").string()) + " " + shell_quote(png.string())),

@@ -21,12 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using clothsim::testing::read_file_bytes;
+using clothsim::testing::run_shell;
 using clothsim::testing::shell_quote;
-
-int run_shell(const std::string& command) {
-  const int status = std::system(command.c_str());
-  return (status != -1 && WIFEXITED(status)) ? WEXITSTATUS(status) : -1;
-}
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> lines;
@@ -38,9 +34,7 @@ std::vector<std::string> lines_of(const std::string& text) {
 class StudyStabilityCli : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "clothsim_stability_cli_XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
+    dir_ = clothsim::testing::make_temp_dir("clothsim_stability_cli_");
   }
   void TearDown() override {
     std::error_code ec;
@@ -90,7 +84,7 @@ TEST_F(StudyStabilityCli, QuickWithoutPlotWritesTheReport) {
   }
 
   // The heat map from this CSV (skipped without Debian's python3-matplotlib).
-  if (run_shell("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) GTEST_SKIP() << "no matplotlib";
+  if (!clothsim::testing::has_matplotlib()) GTEST_SKIP() << "no matplotlib";
   const fs::path png = dir_ / "heatmap.png";
   ASSERT_EQ(run_shell("/usr/bin/python3 " + shell_quote(std::string(CLOTHSIM_SOURCE_DIR) + "/scripts/plot_stability.py") +
                       " " + shell_quote((report / "results.csv").string()) + " " + shell_quote(png.string())),
