@@ -122,8 +122,10 @@ void apply_end_option(Scene& scene, const RunOptions& options) {
     if (scene.analysis != "dynamic") throw std::runtime_error("--frames: only applies to dynamic scenes");
     if (*options.frames < 1) throw std::runtime_error("--frames: must be >= 1");
     const double end = std::max(scene.problem.time.dt, (*options.frames - 1) / scene.problem.time.output_fps);
-    log_line("--frames " + std::to_string(*options.frames) + ": simulating to t = " + shortest(end) + " s");
     scene.problem.time.end = end;
+    if (const std::string problem = time_limit_problem(scene.problem.time); !problem.empty())
+      throw std::runtime_error("--frames: " + problem);
+    log_line("--frames " + std::to_string(*options.frames) + ": simulating to t = " + shortest(end) + " s");
   }
   if (!options.end) return;
   const double end = *options.end;
@@ -138,6 +140,8 @@ void apply_end_option(Scene& scene, const RunOptions& options) {
   log_line("--end: simulating to t = " + shortest(end) + " s instead of time.end = " +
            shortest(scene.problem.time.end) + " s");
   scene.problem.time.end = end;
+  if (const std::string problem = time_limit_problem(scene.problem.time); !problem.empty())
+    throw std::runtime_error("--end: " + problem);
 }
 
 }  // namespace

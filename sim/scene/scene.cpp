@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <fstream>
 #include <limits>
@@ -563,6 +564,19 @@ std::string describe_snap(const Eigen::MatrixX3d& vertices, int v, const Eigen::
          " m from the requested point)";
 }
 
+// A probe or point load must lie on or near the mesh: fails naming `path` if `point` is further
+// from its nearest vertex than the diagonal of the mesh's bounding box.
+void check_near_mesh(const Reader& r, const Eigen::MatrixX3d& vertices, int vertex, const Eigen::Vector3d& point,
+                     const std::string& path) {
+  if (vertex < 0) r.fail(path, "the mesh has no vertices");
+  const double diagonal = (vertices.colwise().maxCoeff() - vertices.colwise().minCoeff()).norm();
+  const double distance = (vertices.row(vertex).transpose() - point).stableNorm();
+  if (!(distance <= diagonal))
+    r.fail(path, "[" + format_number(point.x()) + ", " + format_number(point.y()) + ", " + format_number(point.z()) +
+                     "] is " + format_number(distance) + " m from the nearest vertex, further than the mesh's size (" +
+                     format_number(diagonal) + " m, its bounding box's diagonal); give a point on or near the mesh");
+}
+
 void read_loads(const Reader& r, const Json* j, Problem& problem, double* ramp_time, const LogFn& log) {
   if (j == nullptr) return;
   r.check_object(*j, "loads", {"gravity", "surface_load", "pressure", "point_loads", "moments", "ramp_time"});
@@ -596,6 +610,7 @@ void read_loads(const Reader& r, const Json* j, Problem& problem, double* ramp_t
       PointLoad load;
       load.force = r.vec3(r.require(item, path, "force"), join_key(path, "force"));
       load.vertex = nearest_vertex(problem.mesh.vertices, at);
+      check_near_mesh(r, problem.mesh.vertices, load.vertex, at, join_key(path, "at"));
       log(path + ": " + describe_snap(problem.mesh.vertices, load.vertex, at));
       problem.point_loads.push_back(load);
     }
@@ -611,6 +626,7 @@ TimeSettings read_time(const Reader& r, const Json* j) {
   if (t.end < t.dt)
     r.fail("time.end", "must be >= time.dt = " + format_number(t.dt) + " [s] (got " + format_number(t.end) + ")");
   if (const Json* v = r.find(*j, "output_fps")) t.output_fps = r.positive(*v, "time.output_fps", "[1/s]");
+  if (const std::string problem = time_limit_problem(t); !problem.empty()) r.fail("time", problem);
   return t;
 }
 
@@ -832,6 +848,7 @@ std::vector<Probe> read_probes(const Reader& r, const Json* j, const TriMesh& me
       r.fail(join_key(path, "name"), "duplicate probe name " + quote(probe.name));
     probe.at = r.vec3(r.require(item, path, "at"), join_key(path, "at"));
     probe.vertex = nearest_vertex(mesh.vertices, probe.at);
+    check_near_mesh(r, mesh.vertices, probe.vertex, probe.at, join_key(path, "at"));
     log("probe " + probe.name + ": " + describe_snap(mesh.vertices, probe.vertex, probe.at));
     out.push_back(std::move(probe));
   }
@@ -840,12 +857,30 @@ std::vector<Probe> read_probes(const Reader& r, const Json* j, const TriMesh& me
 
 }  // namespace
 
+std::string time_limit_problem(const TimeSettings& t) {
+  auto count = [](double n) {
+    char buffer[48];
+    std::snprintf(buffer, sizeof buffer, n < 1e15 ? "%.0f" : "%.3g", n);
+    return std::string(buffer);
+  };
+  const double steps = std::ceil(t.end / t.dt - 1e-9);
+  if (!(steps <= kMaxSteps))
+    return "time.end / time.dt = " + format_number(t.end) + " / " + format_number(t.dt) + " needs " + count(steps) +
+           " steps, more than the limit of " + count(kMaxSteps) + " (a larger time.dt or a shorter time.end)";
+  const double frames = std::floor(t.end * t.output_fps + 1e-9) + 1.0;
+  if (!(frames <= kMaxFrames))
+    return "time.output_fps = " + format_number(t.output_fps) + " over time.end = " + format_number(t.end) +
+           " s makes " + count(frames) + " frames, more than the limit of " + count(kMaxFrames);
+  return "";
+}
+
 int nearest_vertex(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& point) {
   int best = -1;
   double best_d2 = std::numeric_limits<double>::infinity();
   for (Eigen::Index v = 0; v < vertices.rows(); ++v) {
-    const double d2 = (vertices.row(v).transpose() - point).squaredNorm();
-    if (d2 < best_d2) {
+    // The (overflow-safe) norm, not its square: a point 1e200 m away must not overflow to infinity.
+    const double d2 = (vertices.row(v).transpose() - point).stableNorm();
+    if (best < 0 || d2 < best_d2) {
       best_d2 = d2;
       best = static_cast<int>(v);
     }

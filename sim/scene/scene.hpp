@@ -85,6 +85,14 @@ Scene load_scene_text(const std::string& text, const std::filesystem::path& file
 // or -1 if there are no vertices.
 int nearest_vertex(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& point);
 
+// Limits of a dynamic run, checked when a scene is read and again after --end / --frames: at most
+// kMaxSteps time steps (⌈end/dt⌉) and kMaxFrames frames (⌊end · output_fps⌋ + 1).
+inline constexpr double kMaxSteps = 1e8;
+inline constexpr double kMaxFrames = 1e6;
+// Empty if `t` is within the limits, otherwise what is wrong (naming time.dt, time.end or
+// time.output_fps and the limit).
+std::string time_limit_problem(const TimeSettings& t);
+
 // Indices (ascending) of the rows p of `vertices` [m] inside the closed box lo <= p <= hi [m].
 std::vector<int> select_box(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& lo,
                             const Eigen::Vector3d& hi);

@@ -349,6 +349,11 @@ TEST_F(CliTest, DynamicInvalidInputWritesNothing) {
   const fs::path plate = write("plate.json", kGridPlate);
   expect_failure(run(shell_quote(plate.string()) + " --out " + shell_quote(out_.string()) + " --end 1"),
                  {"--end: only applies to dynamic scenes"});
+  // Step and frame counts beyond the limits (they once overflowed int and ran -2147483648 steps).
+  expect_failure(run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --end 3e6"),
+                 {"--end: time.end / time.dt = 3000000.0 / 0.001 needs 3000000000 steps, more than the limit of 100000000"});
+  expect_failure(run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --frames 2147483647"),
+                 {"--frames: time.end / time.dt", "more than the limit of 100000000"});
   const fs::path bad = write("bad_dt.json", R"({"analysis": "dynamic",
       "mesh": {"primitive": "grid", "size": [1, 1], "divisions": [4, 4]}, "time": {"dt": -0.01}})");
   expect_failure(run_scene(bad), {bad.string() + ": time.dt: must be > 0 [s] (got -0.01)"});

@@ -746,5 +746,42 @@ TEST(SceneText, SameAsFileAndErrorsNameTheNominalFile) {
   EXPECT_THROW(load_scene_text("{\"mesh\": ", "scenes/variant.json", nullptr), SceneError);
 }
 
+// Regression: a probe or point load far from the mesh once got vertex -1 (1e200² overflowed to a
+// tie at infinity) and the run read memory before the matrix; now it is an error naming the key.
+TEST_F(SceneLoader, FarProbesAndPointLoadsAreErrors) {
+  const Eigen::MatrixX3d vertices = (Eigen::MatrixX3d(2, 3) << 0, 0, 0, 1, 0, 0).finished();
+  for (const double x : {1e200, -1e200, 1e300}) {  // both vertices are equally far in double: either, never -1
+    const int v = nearest_vertex(vertices, Eigen::Vector3d(x, 0, 0));
+    EXPECT_TRUE(v == 0 || v == 1) << x << " gave " << v;
+  }
+  EXPECT_EQ(nearest_vertex(vertices, Eigen::Vector3d(0.9, 1e-3, 0)), 1);
+  const std::string held = R"("boundary": [{"select": {"box": [[-1, -1, -1], [1, -0.4, 1]]}, "fix": ["x", "y", "z"]}])";
+  const std::string probe = error(std::string("{") + kGrid4 + ", " + held + R"(, "probes": [{"name": "p", "at": [1e200, 0, 0]}]})");
+  EXPECT_TRUE(contains(probe, expected("probes[0].at: [1e+200, 0.0, 0.0] is 1e+200 m from the nearest vertex, "
+                                       "further than the mesh's size (1.4142135623730951 m")))
+      << probe;
+  const std::string far_load = error(std::string("{") + kGrid4 + ", " + held +
+                                     R"(, "loads": {"point_loads": [{"at": [0, 0, 3], "force": [0, 0, -1]}]}})");
+  EXPECT_TRUE(contains(far_load, expected("loads.point_loads[0].at: [0.0, 0.0, 3.0] is 3.0 m from the nearest vertex")))
+      << far_load;
+  // Within the mesh's size a point still snaps to its nearest vertex (the documented behaviour).
+  EXPECT_NO_THROW(load(std::string("{") + kGrid4 + ", " + held + R"(, "probes": [{"name": "p", "at": [0.9, 0, 0.5]}]})"));
+}
+
+// Regression: dt = 1e-12 over 1 s overflowed the step count; an output_fps of 1e308 wrote frames
+// for ever at t = 0. Both are limits now, checked when the scene is read.
+TEST_F(SceneLoader, StepAndFrameCountsHaveLimits) {
+  const std::string dynamic = std::string(R"({"analysis": "dynamic", )") + kGrid4;
+  EXPECT_TRUE(contains(error(dynamic + R"(, "time": {"dt": 1e-12, "end": 1.0}})"),
+                       expected("time: time.end / time.dt = 1.0 / 1e-12 needs 1000000000000 steps, more than the limit of "
+                                "100000000")));
+  EXPECT_TRUE(contains(error(dynamic + R"(, "time": {"dt": 0.001, "end": 1.0, "output_fps": 1e308}})"),
+                       expected("time: time.output_fps = 1e+308 over time.end = 1.0 s makes 1e+308 frames")));
+  EXPECT_TRUE(contains(error(dynamic + R"(, "time": {"dt": 0.001, "end": 1.0, "output_fps": 1e308}})"),
+                       "more than the limit of 1000000"));
+  // At the limits themselves the scene is accepted: 1e8 steps and 1e6 frames.
+  EXPECT_NO_THROW(load(dynamic + R"(, "time": {"dt": 1e-8, "end": 1.0, "output_fps": 999999}})"));
+}
+
 }  // namespace
 }  // namespace clothsim
