@@ -36,9 +36,10 @@ int render_command(int argc, char** argv) {
   app.add_option("dir", dir, "Output folder of a run (with frames/mesh_*.obj)")->required()->type_name("DIR");
   app.add_option("--size", size, "Image size, e.g. 960x720")->type_name("WxH");
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
-  int width = 0, height = 0;
-  if (!size.empty() && (std::sscanf(size.c_str(), "%dx%d", &width, &height) != 2 || width < 16 || height < 16 ||
-                        width > 8192 || height > 8192)) {
+  int width = 0, height = 0, used = 0;
+  if (!size.empty() && (std::sscanf(size.c_str(), "%dx%d%n", &width, &height, &used) != 2 ||
+                        used != static_cast<int>(size.size()) || width < 16 || height < 16 || width > 8192 ||
+                        height > 8192)) {
     std::cerr << "clothsim: error: --size: expected WxH with 16 <= W, H <= 8192 (got \"" << size << "\")\n";
     return 1;
   }
@@ -134,6 +135,10 @@ int figures_command(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "--version") {
+    std::cout << "clothsim " << CLOTHSIM_VERSION << '\n';
+    return 0;
+  }
   if (argc >= 2 && std::string(argv[1]) == "render") return render_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "study") return study_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "figures") return figures_command(argc, argv);

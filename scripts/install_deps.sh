@@ -3,7 +3,7 @@
 # Usage: scripts/install_deps.sh   (runs apt-get through sudo when not root)
 set -euo pipefail
 packages=(
-  cmake g++ make pkg-config ninja-build
+  cmake g++ make pkg-config
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libpng-dev libosmesa6-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libcgal-dev
   python3-minimal python3-matplotlib

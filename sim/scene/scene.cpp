@@ -80,8 +80,12 @@ std::string describe(const Json& j) {
   }
 }
 
+// At most this many characters, so that the output folder and its temporary siblings
+// (".<name>.tmp-<pid>", ".<name>.old-<pid>") fit a file name (255 bytes on common file systems).
+constexpr std::size_t kMaxNameLength = 200;
+
 bool is_safe_name(const std::string& name) {
-  if (name.empty() || name.front() == '.') return false;
+  if (name.empty() || name.front() == '.' || name.size() > kMaxNameLength) return false;
   for (char c : name) {
     const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
                     c == '_' || c == '-' || c == '.';
@@ -978,8 +982,12 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   if (const Json* name = r.find(root, "name")) {
     scene.name = r.string(*name, "name");
     if (!is_safe_name(scene.name))
-      r.fail("name", "must be a safe folder name: letters, digits, '_', '-', '.', not starting with '.' (got " +
-                         quote(scene.name) + ")");
+      r.fail("name", "must be a safe folder name: at most " + std::to_string(kMaxNameLength) +
+                         " letters, digits, '_', '-', '.', not starting with '.' (got " +
+                         (scene.name.size() > 60 ? quote(scene.name.substr(0, 40)) + "... (" +
+                                                       std::to_string(scene.name.size()) + " characters)"
+                                                 : quote(scene.name)) +
+                         ")");
   } else {
     scene.name = file.stem().string();
     if (!is_safe_name(scene.name))

@@ -139,6 +139,19 @@ class CliTest : public ::testing::Test {
   fs::path out_;
 };
 
+TEST_F(CliTest, VersionPrintsTheProjectVersion) {
+  const RunResult r = run("--version");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "clothsim " CLOTHSIM_TEST_VERSION "\n");
+}
+
+// Regression: `clothsim render --size 64x48abc` was accepted while a normal run refused it.
+TEST_F(CliTest, RenderRefusesTrailingCharactersInSize) {
+  const RunResult r = run("render " + shell_quote(dir_.string()) + " --size 64x48abc");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_TRUE(contains(r.err, "--size: expected WxH with 16 <= W, H <= 8192 (got \"64x48abc\")")) << r.err;
+}
+
 TEST_F(CliTest, HelpExitsZero) {
   const RunResult r = run("--help");
   EXPECT_EQ(r.exit_code, 0);

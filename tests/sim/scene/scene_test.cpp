@@ -783,5 +783,16 @@ TEST_F(SceneLoader, StepAndFrameCountsHaveLimits) {
   EXPECT_NO_THROW(load(dynamic + R"(, "time": {"dt": 1e-8, "end": 1.0, "output_fps": 999999}})"));
 }
 
+// Regression: a 5000-character name was accepted and failed only when the output folder was made,
+// after solving; now it is refused when the scene is read, and the message does not echo it whole.
+TEST_F(SceneLoader, OverlongNamesAreRefusedUpFront) {
+  const std::string long_name(5000, 'a');
+  const std::string message = error(std::string(R"({"name": ")") + long_name + R"(", )" + kGrid4 + "}");
+  EXPECT_TRUE(contains(message, expected("name: must be a safe folder name: at most 200 letters"))) << message;
+  EXPECT_TRUE(contains(message, "(5000 characters)")) << message;
+  EXPECT_LT(message.size(), 400u);
+  EXPECT_NO_THROW(load(std::string(R"({"name": ")") + std::string(200, 'b') + R"(", )" + kGrid4 + "}"));
+}
+
 }  // namespace
 }  // namespace clothsim
