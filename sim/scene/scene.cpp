@@ -147,13 +147,31 @@ class DuplicateKeyFinder {
   std::string first_;
 };
 
+// `text` with every control character (below 0x20, and 0x7f) written as \uXXXX.
+std::string printable(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof buffer, "\\u%04x", static_cast<unsigned>(u));
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 // Typed, checked access to the JSON tree; every failure throws SceneError naming file and key.
 class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
+  // Control characters (a NUL in a key would cut the message short) are written as \uXXXX.
   [[noreturn]] void fail(const std::string& path, const std::string& problem) const {
-    throw SceneError(file_ + ": " + (path.empty() ? std::string() : path + ": ") + problem);
+    throw SceneError(printable(file_ + ": " + (path.empty() ? std::string() : path + ": ") + problem));
   }
 
   // `j` must be an object whose keys are all in `allowed`.
@@ -297,6 +315,13 @@ Json parse_text(const Reader& r, const std::string& text) {
     if (!message.empty() && message.front() == '[') {
       const auto close = message.find("] ");
       if (close != std::string::npos) message = message.substr(close + 2);
+    }
+    // nlohmann quotes everything it read of the bad token ("last read: '...'"): keep its end only.
+    constexpr std::size_t kShown = 60;
+    if (const auto at = message.find("last read: '"); at != std::string::npos) {
+      const auto from = at + 12, to = message.rfind('\'');
+      if (to != std::string::npos && to > from && to - from > kShown)
+        message = message.substr(0, from) + "..." + message.substr(to - kShown);
     }
     r.fail("", "malformed JSON: " + message);
   }

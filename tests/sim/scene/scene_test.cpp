@@ -794,5 +794,17 @@ TEST_F(SceneLoader, OverlongNamesAreRefusedUpFront) {
   EXPECT_NO_THROW(load(std::string(R"({"name": ")") + std::string(200, 'b') + R"(", )" + kGrid4 + "}"));
 }
 
+// Regressions: a key with a NUL in it printed an empty message (what() stopped at the NUL), and a
+// parse error echoed the whole bad token (84 KB for a long one).
+TEST_F(SceneLoader, ErrorMessagesArePrintableAndShort) {
+  const std::string nul_key = error(std::string("{") + kGrid4 + R"(, "lo\u0000ads": {}})");
+  EXPECT_EQ(std::string(nul_key.c_str()), nul_key);  // no NUL inside
+  EXPECT_TRUE(contains(nul_key, "lo\\u0000ads")) << nul_key;
+  EXPECT_TRUE(contains(nul_key, "unknown key")) << nul_key;
+  const std::string long_token = error(std::string("{") + kGrid4 + R"(, "name": x)" + std::string(84000, 'y') + "}");
+  EXPECT_TRUE(contains(long_token, "malformed JSON")) << long_token.substr(0, 300);
+  EXPECT_LT(long_token.size(), 400u) << long_token.substr(0, 300);
+}
+
 }  // namespace
 }  // namespace clothsim
