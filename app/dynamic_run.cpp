@@ -85,19 +85,6 @@ class StreamFile {
   std::ofstream out_;
 };
 
-// Writes `text` to `path` through a temporary sibling and a rename, so a reader never sees a
-// half-written file.
-void write_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp");
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.close();
-    if (!out) throw std::runtime_error(tmp.string() + ": cannot write the file");
-  }
-  fs::rename(tmp, path);
-}
-
 // Creates a fresh, empty `root/<name>`. An older folder of that name is first renamed to
 // `root/.<name>.old-<pid>` and deleted once the new one exists (restored if creating it fails).
 // On failure removes the folders it created and throws.

@@ -133,21 +133,6 @@ std::vector<FigureSpec> figure_specs() {
   return figures;
 }
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error(path.string() + ": cannot read the file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// Writes `text` to `path` through a temporary sibling and a rename (whole or absent).
-void write_whole(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp-" + std::to_string(::getpid()));
-  write_text_file(tmp, text);
-  fs::rename(tmp, path);
-}
-
 std::string fixed(double v, int digits) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", digits, v);
@@ -187,7 +172,7 @@ PreparedRun prepare(const RunSpec& spec, const fs::path& scenes_dir, double need
   const fs::path source = scenes_dir / spec.scene;
   Json scene;
   try {
-    scene = Json::parse(read_text(source));
+    scene = Json::parse(read_text_file(source));
   } catch (const Json::exception& e) {
     throw std::runtime_error(source.string() + ": " + e.what());
   }
@@ -224,7 +209,7 @@ std::optional<Json> completed_summary(const fs::path& dir) {
   std::error_code ec;
   if (!fs::exists(dir / "summary.json", ec)) return std::nullopt;
   try {
-    Json summary = Json::parse(read_text(dir / "summary.json"));
+    Json summary = Json::parse(read_text_file(dir / "summary.json"));
     if (summary.value("status", std::string()) == "completed") return summary;
   } catch (const std::exception&) {
   }
@@ -237,7 +222,7 @@ void execute(PreparedRun& run, const fs::path& root, const FiguresOptions& optio
   const fs::path dir = root / "runs" / run.spec.id;
   const std::string stamp = stamp_of(run, options);
   std::error_code ec;
-  if (!options.rerun && fs::exists(stamp_file, ec) && read_text(stamp_file) == stamp) {
+  if (!options.rerun && fs::exists(stamp_file, ec) && read_text_file(stamp_file) == stamp) {
     if (const auto summary = completed_summary(dir)) {
       run.reused = true;
       run.wall_seconds = summary->value("wall_seconds", 0.0);
@@ -245,7 +230,7 @@ void execute(PreparedRun& run, const fs::path& root, const FiguresOptions& optio
       return;
     }
   }
-  write_whole(scene_file, run.scene_text);
+  write_atomically(scene_file, run.scene_text);
   fs::remove(stamp_file, ec);
   RunOptions run_options;
   run_options.width = options.width;
@@ -263,7 +248,7 @@ void execute(PreparedRun& run, const fs::path& root, const FiguresOptions& optio
   const auto summary = completed_summary(dir);
   if (!summary) throw std::runtime_error("figure run " + run.spec.id + ": " + dir.string() + " did not complete");
   run.wall_seconds = summary->value("wall_seconds", 0.0);
-  write_whole(stamp_file, stamp);
+  write_atomically(stamp_file, stamp);
 }
 
 // The frame a panel shows: index round(t · fps), clamped to the frames a quick run has.
@@ -416,7 +401,7 @@ int run_figures(const FiguresOptions& options) {
       }
       const fs::path png = root / ("fig" + std::to_string(figure.number) + ".png");
       montage(figure, panels, png);
-      write_whole(root / ("fig" + std::to_string(figure.number) + ".md"),
+      write_atomically(root / ("fig" + std::to_string(figure.number) + ".md"),
                   figure_markdown(figure, panels, panel_runs, options));
       std::cout << "figures: wrote " << png.string() << '\n';
     }
@@ -428,9 +413,9 @@ int run_figures(const FiguresOptions& options) {
     for (int n : figure_numbers()) {
       const fs::path md = root / ("fig" + std::to_string(n) + ".md");
       std::error_code ec;
-      if (fs::exists(md, ec)) index += read_text(md) + "\n";
+      if (fs::exists(md, ec)) index += read_text_file(md) + "\n";
     }
-    write_whole(root / "figures.md", index);
+    write_atomically(root / "figures.md", index);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cout << "figures: " << wanted.size() << " figure(s) in " << fixed(seconds, 1) << " s; wrote "
               << (root / "figures.md").string() << '\n';

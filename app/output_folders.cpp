@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -24,6 +25,29 @@ void write_text_file(const std::filesystem::path& path, const std::string& text)
   out << text;
   out.close();
   if (!out) throw std::runtime_error(path.string() + ": cannot write the file");
+}
+
+void write_atomically(const std::filesystem::path& path, const std::string& text) {
+  std::string name = ".";  // built with += (GCC 12 warns falsely on "." + std::string&&)
+  name += path.filename().string();
+  name += ".tmp-";
+  name += std::to_string(static_cast<long>(::getpid()));
+  const std::filesystem::path tmp = path.parent_path() / name;
+  write_text_file(tmp, text);
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error(path.string() + ": cannot write the file (rename failed)");
+  }
+}
+
+std::string read_text_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": cannot read the file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 std::string replace_folder(const std::filesystem::path& staging, const std::filesystem::path& target) {

@@ -15,6 +15,13 @@ std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& 
 // when the file cannot be written.
 void write_text_file(const std::filesystem::path& path, const std::string& text);
 
+// Writes `text` to `path` through a temporary sibling (".<name>.tmp-<pid>") and a rename, so a
+// reader never sees a half-written file; throws std::runtime_error naming the path on failure.
+void write_atomically(const std::filesystem::path& path, const std::string& text);
+
+// The whole file as text; throws std::runtime_error naming the path if it cannot be read.
+std::string read_text_file(const std::filesystem::path& path);
+
 // Renames the finished folder `staging` to `target`, replacing an older `target` only once the
 // new one is in place: the old one is moved aside to a hidden sibling (".<name>.old-<pid>"),
 // restored if the rename fails (and the error rethrown), and deleted afterwards. Returns a
