@@ -1,9 +1,12 @@
 #include "app/output_folders.hpp"
 
+#include "app/plotting.hpp"
+
 #include <unistd.h>
 
 #include <cstdint>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -72,6 +75,35 @@ std::string replace_folder(const std::filesystem::path& staging, const std::file
   if (replacing && fs::remove_all(old, ec) == static_cast<std::uintmax_t>(-1))
     return "could not remove the previous output " + old.string() + ": " + ec.message();
   return "";
+}
+
+std::string publish_report(const std::filesystem::path& out_root, const std::string& folder,
+                           const std::vector<ReportFile>& files, bool plot, const std::string& plot_script,
+                           const std::string& png) {
+  namespace fs = std::filesystem;
+  std::string staging_name = ".";  // built with += (GCC 12 warns falsely on "." + std::string&&)
+  staging_name += folder;
+  staging_name += ".tmp-";
+  staging_name += std::to_string(static_cast<long>(::getpid()));
+  const fs::path staging = out_root / staging_name;
+  const std::vector<fs::path> created = missing_folders(out_root);
+  try {
+    fs::create_directories(out_root);
+    fs::remove_all(staging);
+    fs::create_directory(staging);
+    for (const ReportFile& f : files) write_text_file(staging / f.name, f.text);
+    std::string plot_error;
+    if (plot && !files.empty())
+      plot_error = run_plot_script(plot_script, {(staging / files.front().name).string(), (staging / png).string()});
+    if (const std::string warning = replace_folder(staging, out_root / folder); !warning.empty())
+      std::cerr << "clothsim: warning: " << warning << '\n';
+    return plot_error;
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(staging, ec);
+    for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if still empty
+    throw;
+  }
 }
 
 }  // namespace clothsim

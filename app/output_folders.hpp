@@ -28,4 +28,17 @@ std::string read_text_file(const std::filesystem::path& path);
 // warning (empty if none) when the old folder could not be deleted.
 std::string replace_folder(const std::filesystem::path& staging, const std::filesystem::path& target);
 
+// A study's report folder out_root/<folder>/, published whole: the `files` (name, text) are written
+// to out_root/.<folder>.tmp-<pid>, the PNG `png` is drawn from the first file (a CSV) by
+// scripts/<plot_script> unless `plot` is false, and the folder is renamed into place (replacing an
+// older one only then). Returns the plot's error ("" if none or not drawn): the folder is published
+// with the data even then. Throws std::runtime_error if the data cannot be written; the temporary
+// folder and any output-root folders it created are removed again.
+struct ReportFile {
+  std::string name, text;
+};
+std::string publish_report(const std::filesystem::path& out_root, const std::string& folder,
+                           const std::vector<ReportFile>& files, bool plot, const std::string& plot_script,
+                           const std::string& png);
+
 }  // namespace clothsim

@@ -8,12 +8,10 @@
 // older report is replaced only then. If only the plot fails, the folder (with the CSV) is still
 // published and the command exits with 1.
 #include "app/output_folders.hpp"
-#include "app/plotting.hpp"
 #include "app/study.hpp"
 #include "sim/study/convergence.hpp"
 #include "sim/study/report_format.hpp"
 
-#include <unistd.h>
 
 #include <chrono>
 #include <fstream>
@@ -43,8 +41,6 @@ std::string text_of(void (*write)(std::ostream&, const std::vector<ConvergenceRo
 
 int run_convergence_study(const StudyOptions& options) {
   const fs::path target = options.out_root / "study_convergence";
-  const fs::path staging = options.out_root / (".study_convergence.tmp-" + std::to_string(::getpid()));
-  std::vector<fs::path> created;
   try {
     const auto start = std::chrono::steady_clock::now();
     const fs::path scenes = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
@@ -52,20 +48,11 @@ int run_convergence_study(const StudyOptions& options) {
     const std::vector<ConvergenceRow> rows = run_convergence(plan, convergence_methods(), [](const std::string& line) {
       std::cerr << "clothsim: convergence: " << line << std::endl;
     });
-
-    created = missing_folders(options.out_root);
-    fs::create_directories(options.out_root);
-    fs::remove_all(staging);
-    fs::create_directory(staging);
-    const fs::path csv = staging / "results.csv";
-    write_text_file(csv, text_of(write_results_csv, rows));
-    write_text_file(staging / "results.md", text_of(write_results_markdown, rows));
-
-    std::string plot_error;
-    if (options.plot)
-      plot_error = run_plot_script("plot_convergence.py", {csv.string(), (staging / "error_vs_time.png").string()});
-    if (const std::string warning = replace_folder(staging, target); !warning.empty())
-      std::cerr << "clothsim: warning: " << warning << '\n';
+    const std::string plot_error =
+        publish_report(options.out_root, "study_convergence",
+                       {{"results.csv", text_of(write_results_csv, rows)},
+                        {"results.md", text_of(write_results_markdown, rows)}},
+                       options.plot, "plot_convergence.py", "error_vs_time.png");
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::cout << "convergence study: " << rows.size() << " rows in " << format_fixed(seconds, 1) << " s; wrote "
               << (target / "results.csv").string() << (options.plot && plot_error.empty() ? " and error_vs_time.png" : "")
@@ -77,9 +64,6 @@ int run_convergence_study(const StudyOptions& options) {
     }
     return 0;
   } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove_all(staging, ec);
-    for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if still empty
     std::cerr << "clothsim: error: convergence study: " << e.what() << '\n';
     return 1;
   }

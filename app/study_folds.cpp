@@ -9,12 +9,10 @@
 // report is replaced only then. A run that fails is a row with a note, not the end of the study.
 // If only the plot fails, the folder (with the CSV) is still published and the command exits 1.
 #include "app/output_folders.hpp"
-#include "app/plotting.hpp"
 #include "app/study.hpp"
 #include "sim/study/fold_study.hpp"
 #include "sim/study/report_format.hpp"
 
-#include <unistd.h>
 
 #include <chrono>
 #include <iostream>
@@ -31,8 +29,6 @@ namespace clothsim {
 int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args) {
   namespace fs = std::filesystem;
   const fs::path target = options.out_root / "study_folds";
-  const fs::path staging = options.out_root / (".study_folds.tmp-" + std::to_string(::getpid()));
-  std::vector<fs::path> created;
   FoldStudyPlan plan;
   try {
     // The plan and its options: a bad option is reported before anything runs or is written.
@@ -56,21 +52,12 @@ int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args
     const std::vector<FoldRow> rows =
         run_fold_study(plan, [](const std::string& line) { std::cerr << "clothsim: folds: " << line << std::endl; });
 
-    created = missing_folders(options.out_root);
-    fs::create_directories(options.out_root);
-    fs::remove_all(staging);
-    fs::create_directory(staging);
     std::ostringstream csv_text, md_text;
     write_fold_csv(csv_text, rows);
     write_fold_markdown(md_text, rows);
-    const fs::path csv = staging / "results.csv";
-    write_text_file(csv, csv_text.str());
-    write_text_file(staging / "results.md", md_text.str());
-
-    std::string plot_error;
-    if (options.plot) plot_error = run_plot_script("plot_folds.py", {csv.string(), (staging / "folds_vs_vertices.png").string()});
-    if (const std::string warning = replace_folder(staging, target); !warning.empty())
-      std::cerr << "clothsim: warning: " << warning << '\n';
+    const std::string plot_error =
+        publish_report(options.out_root, "study_folds", {{"results.csv", csv_text.str()}, {"results.md", md_text.str()}},
+                       options.plot, "plot_folds.py", "folds_vs_vertices.png");
     int failed = 0;
     for (const FoldRow& r : rows) failed += r.status != "ok";
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -84,9 +71,6 @@ int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args
     }
     return 0;
   } catch (const std::exception& e) {
-    std::error_code ec;
-    fs::remove_all(staging, ec);
-    for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if still empty
     std::cerr << "clothsim: error: fold study: " << e.what() << '\n';
     return 1;
   }
