@@ -2,6 +2,7 @@
 // messages carry the file and the key path), builds the mesh, the Problem and, for dynamic
 // scenes, the Problem.
 #include "sim/scene/scene.hpp"
+#include "sim/scene/render_settings_json.hpp"
 
 #include "sim/mesh/imperfection.hpp"
 
@@ -978,6 +979,10 @@ RenderSettings read_render(const Reader& r, const Json* j) {
       r.fail("render.camera.up", "must not be parallel to the viewing direction");
   }
   return s;
+}
+
+RenderSettings render_settings_from_json(const Json& render, const std::string& where) {
+  return read_render(Reader(where), &render);
 }
 
 namespace {
