@@ -124,13 +124,6 @@ std::string gl_error_name(GLenum error) {
   }
 }
 
-void check_gl(const char* what) {
-  const GLenum error = glGetError();
-  if (error != GL_NO_ERROR) {
-    throw std::runtime_error(std::string("Renderer: ") + what + " failed: " + gl_error_name(error));
-  }
-}
-
 std::string framebuffer_status_name(GLenum status) {
   switch (status) {
     case GL_FRAMEBUFFER_UNDEFINED:
@@ -295,7 +288,14 @@ struct DepthRange {
 
 struct Renderer::Impl {
   OSMesaContext context = nullptr;
-  std::vector<unsigned char> default_buffer;  // OSMesa's window buffer (unused: we draw to FBOs)
+  // OSMesa's window buffer, 4 x 4 RGBA (unused: we draw to FBOs). Held by pointer so that a
+  // context abandoned after a failure (see `failure`) keeps a valid buffer.
+  std::unique_ptr<unsigned char[]> default_buffer;
+  // Set when a GL or OSMesa call failed after the context was created. The context's state is
+  // then unknown (a failed allocation may leave queued work that any flush would run, and
+  // OSMesaMakeCurrent flushes): render() refuses to run and the destructor makes no further
+  // OSMesa call on it, abandoning the context instead of crashing in its teardown.
+  std::string failure;
   int max_width = 0;
   int max_height = 0;
   RendererInfo info;
@@ -323,18 +323,21 @@ struct Renderer::Impl {
   ~Impl();
   void make_current();
   void create_context();
-  void destroy_context();
+  void destroy_context() noexcept;
   void setup_pipeline(int requested_samples);
   void ensure_framebuffers(int width, int height);
   void delete_framebuffers();
+  [[noreturn]] void fail(const std::string& message);
+  void check(const char* what);
   Image render(const Frame& frame);
-  void draw_mesh(const Mesh& mesh);
+  void draw(const Frame& frame, const std::vector<std::vector<float>>& mesh_vertices, Image& image);
+  void draw_mesh(const Mesh& mesh, const std::vector<float>& vertices);
   void draw_lines(const Lines& lines);
   void draw_ground(const Frame& frame, const Vec3f& centre, float half_size);
 };
 
 Renderer::Impl::Impl(int width, int height, int samples)
-    : default_buffer(4 * 4 * 4), max_width(width), max_height(height) {
+    : default_buffer(std::make_unique<unsigned char[]>(4 * 4 * 4)), max_width(width), max_height(height) {
   if (width <= 0 || height <= 0) {
     throw std::invalid_argument("Renderer: maximum size must be positive, got " +
                                 std::to_string(width) + " x " + std::to_string(height));
@@ -350,12 +353,32 @@ Renderer::Impl::Impl(int width, int height, int samples)
 
 Renderer::Impl::~Impl() { destroy_context(); }
 
-void Renderer::Impl::destroy_context() {
+void Renderer::Impl::destroy_context() noexcept {
   if (context == nullptr) return;
-  // Destroying the context frees every GL object it owns.
+  if (!failure.empty()) {
+    // A failed context is abandoned, not destroyed: releasing it (OSMesaMakeCurrent) or
+    // destroying it (which makes it current internally) flushes whatever the failure left
+    // queued, and that flush is where a renderer that ran out of memory crashed. The context
+    // and its window buffer stay allocated until the process exits.
+    static_cast<void>(default_buffer.release());
+    context = nullptr;
+    return;
+  }
+  // Destroying the context frees every GL object it owns. Nothing is queued: every render()
+  // ends with a read-back, which waits for the drawing.
   if (OSMesaGetCurrentContext() == context) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
   OSMesaDestroyContext(context);
   context = nullptr;
+}
+
+void Renderer::Impl::fail(const std::string& message) {
+  if (failure.empty()) failure = message;
+  throw std::runtime_error(message);
+}
+
+void Renderer::Impl::check(const char* what) {
+  const GLenum error = glGetError();
+  if (error != GL_NO_ERROR) fail(std::string("Renderer: ") + what + " failed: " + gl_error_name(error));
 }
 
 void Renderer::Impl::create_context() {
@@ -399,8 +422,8 @@ void Renderer::Impl::create_context() {
 
 void Renderer::Impl::make_current() {
   if (OSMesaGetCurrentContext() == context) return;
-  if (!OSMesaMakeCurrent(context, default_buffer.data(), GL_UNSIGNED_BYTE, 4, 4)) {
-    throw std::runtime_error("Renderer: OSMesaMakeCurrent failed");
+  if (!OSMesaMakeCurrent(context, default_buffer.get(), GL_UNSIGNED_BYTE, 4, 4)) {
+    fail("Renderer: OSMesaMakeCurrent failed (out of memory?)");
   }
 }
 
@@ -422,7 +445,7 @@ void Renderer::Impl::setup_pipeline(int requested_samples) {
   glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
   glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
   glGetFloatv(GL_ALIASED_LINE_WIDTH_RANGE, line_width_range);
-  check_gl("querying implementation limits");
+  check("querying implementation limits");
   info.samples = std::clamp(requested_samples, 1, std::max(max_samples, 1));
   if (max_width > std::min(max_renderbuffer, max_viewport[0]) ||
       max_height > std::min(max_renderbuffer, max_viewport[1])) {
@@ -458,7 +481,7 @@ void Renderer::Impl::setup_pipeline(int requested_samples) {
   glDisable(GL_CULL_FACE);
   glEnable(GL_MULTISAMPLE);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  check_gl("setting up the GL pipeline");
+  check("setting up the GL pipeline");
 }
 
 void Renderer::Impl::delete_framebuffers() {
@@ -489,10 +512,9 @@ void Renderer::Impl::ensure_framebuffers(int width, int height) {
   GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     delete_framebuffers();
-    throw std::runtime_error("Renderer: the " + std::to_string(samples) +
-                             "-sample framebuffer of " + std::to_string(width) + " x " +
-                             std::to_string(height) +
-                             " is incomplete: " + framebuffer_status_name(status));
+    fail("Renderer: the " + std::to_string(samples) + "-sample framebuffer of " +
+         std::to_string(width) + " x " + std::to_string(height) +
+         " is incomplete (out of memory?): " + framebuffer_status_name(status));
   }
 
   glGenRenderbuffers(1, &resolve_color);
@@ -504,23 +526,23 @@ void Renderer::Impl::ensure_framebuffers(int width, int height) {
   status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE) {
     delete_framebuffers();
-    throw std::runtime_error("Renderer: the resolve framebuffer of " + std::to_string(width) +
-                             " x " + std::to_string(height) +
-                             " is incomplete: " + framebuffer_status_name(status));
+    fail("Renderer: the resolve framebuffer of " + std::to_string(width) + " x " +
+         std::to_string(height) + " is incomplete (out of memory?): " +
+         framebuffer_status_name(status));
   }
-  check_gl("allocating framebuffers");
+  check("allocating framebuffers");
   fb_width = width;
   fb_height = height;
 }
 
-void Renderer::Impl::draw_mesh(const Mesh& mesh) {
+void Renderer::Impl::draw_mesh(const Mesh& mesh, const std::vector<float>& vertices) {
   if (mesh.triangles.empty()) return;
-  const std::vector<float> vertices = interleave(mesh);
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)),
                vertices.data(), GL_STREAM_DRAW);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(unsigned)),
                mesh.triangles.data(), GL_STREAM_DRAW);
+  check("uploading a mesh");  // no draw call on a buffer without storage
   glEnableVertexAttribArray(0);
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
@@ -564,6 +586,7 @@ void Renderer::Impl::draw_lines(const Lines& lines) {
   glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                static_cast<GLsizeiptr>(lines.segments.size() * sizeof(unsigned)),
                lines.segments.data(), GL_STREAM_DRAW);
+  check("uploading lines");
   glEnableVertexAttribArray(0);
   glDisableVertexAttribArray(1);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
@@ -573,6 +596,10 @@ void Renderer::Impl::draw_lines(const Lines& lines) {
 }
 
 Image Renderer::Impl::render(const Frame& frame) {
+  if (!failure.empty()) {
+    throw std::runtime_error("Renderer: unusable after an earlier failure (" + failure +
+                             "); create a new Renderer");
+  }
   // Validate everything before touching GL.
   require(
       frame.width > 0 && frame.height > 0 && frame.width <= max_width && frame.height <= max_height,
@@ -631,66 +658,85 @@ Image Renderer::Impl::render(const Frame& frame) {
       frame.camera.fov_deg, static_cast<float>(frame.width) / static_cast<float>(frame.height),
       static_cast<float>(near_plane), static_cast<float>(far_plane));
 
-  make_current();
-  ensure_framebuffers(frame.width, frame.height);
-  glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
-  glViewport(0, 0, frame.width, frame.height);
-  glClearColor(frame.background[0], frame.background[1], frame.background[2], 1.0f);
-  glClearDepth(1.0);
-  glDepthMask(GL_TRUE);
-  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  glBindVertexArray(vao);
-
-  glUseProgram(surface_program);
-  glUniformMatrix4fv(surface_view, 1, GL_FALSE, view.data());
-  glUniformMatrix4fv(surface_projection, 1, GL_FALSE, projection.data());
-  glUniform3fv(surface_background, 1, frame.background.data());
-  glEnable(GL_POLYGON_OFFSET_FILL);
-  // Meshes are pushed slightly back so that coincident wireframe lines win the depth test;
-  // the ground further still so that cloth lying on it stays visible.
-  glPolygonOffset(1.0f, 1.0f);
-  for (const Mesh& mesh : frame.meshes) draw_mesh(mesh);
-  if (frame.ground) {
-    glPolygonOffset(4.0f, 16.0f);
-    draw_ground(frame, ground_centre, ground_half_size);
+  // Every allocation of the frame comes before the first GL call, so that running out of memory
+  // here (std::bad_alloc) leaves the context untouched and usable.
+  std::vector<std::vector<float>> mesh_vertices;
+  mesh_vertices.reserve(frame.meshes.size());
+  for (const Mesh& mesh : frame.meshes) {
+    mesh_vertices.push_back(mesh.triangles.empty() ? std::vector<float>() : interleave(mesh));
   }
-  glDisable(GL_POLYGON_OFFSET_FILL);
-
-  if (!frame.lines.empty()) {
-    glUseProgram(line_program);
-    glUniformMatrix4fv(line_view, 1, GL_FALSE, view.data());
-    glUniformMatrix4fv(line_projection, 1, GL_FALSE, projection.data());
-    for (const Lines& lines : frame.lines) draw_lines(lines);
-  }
-  check_gl("drawing");
-
-  // Resolve the samples, then read back (GL rows run bottom-up: flip to top row first).
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
-  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
-  glBlitFramebuffer(0, 0, frame.width, frame.height, 0, 0, frame.width, frame.height,
-                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
-  // RGBA is Mesa's fast read-back path (a plain copy); dropping alpha here is cheaper than
-  // letting GL convert to RGB.
   const std::size_t width = static_cast<std::size_t>(frame.width);
   const std::size_t rows = static_cast<std::size_t>(frame.height);
   read_buffer.resize(4 * width * rows);
-  glReadPixels(0, 0, frame.width, frame.height, GL_RGBA, GL_UNSIGNED_BYTE, read_buffer.data());
-  check_gl("reading back the image");
-
   Image image;
   image.width = frame.width;
   image.height = frame.height;
   image.rgb.resize(3 * width * rows);
-  for (std::size_t y = 0; y < rows; ++y) {
-    const std::uint8_t* source = read_buffer.data() + 4 * width * (rows - 1 - y);
-    std::uint8_t* target = image.rgb.data() + 3 * width * y;
-    for (std::size_t x = 0; x < width; ++x) {
-      target[3 * x] = source[4 * x];
-      target[3 * x + 1] = source[4 * x + 1];
-      target[3 * x + 2] = source[4 * x + 2];
+
+  // Any failure from here on leaves the context in an unknown state (see `failure`).
+  try {
+    make_current();
+    ensure_framebuffers(frame.width, frame.height);
+    glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+    glViewport(0, 0, frame.width, frame.height);
+    glClearColor(frame.background[0], frame.background[1], frame.background[2], 1.0f);
+    glClearDepth(1.0);
+    glDepthMask(GL_TRUE);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glBindVertexArray(vao);
+
+    glUseProgram(surface_program);
+    glUniformMatrix4fv(surface_view, 1, GL_FALSE, view.data());
+    glUniformMatrix4fv(surface_projection, 1, GL_FALSE, projection.data());
+    glUniform3fv(surface_background, 1, frame.background.data());
+    glEnable(GL_POLYGON_OFFSET_FILL);
+    // Meshes are pushed slightly back so that coincident wireframe lines win the depth test;
+    // the ground further still so that cloth lying on it stays visible.
+    glPolygonOffset(1.0f, 1.0f);
+    for (std::size_t i = 0; i < frame.meshes.size(); ++i) {
+      draw_mesh(frame.meshes[i], mesh_vertices[i]);
     }
+    if (frame.ground) {
+      glPolygonOffset(4.0f, 16.0f);
+      draw_ground(frame, ground_centre, ground_half_size);
+    }
+    glDisable(GL_POLYGON_OFFSET_FILL);
+
+    if (!frame.lines.empty()) {
+      glUseProgram(line_program);
+      glUniformMatrix4fv(line_view, 1, GL_FALSE, view.data());
+      glUniformMatrix4fv(line_projection, 1, GL_FALSE, projection.data());
+      for (const Lines& lines : frame.lines) draw_lines(lines);
+    }
+    check("drawing");
+
+    // Resolve the samples, then read back (GL rows run bottom-up: flip to top row first).
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
+    glBlitFramebuffer(0, 0, frame.width, frame.height, 0, 0, frame.width, frame.height,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    // RGBA is Mesa's fast read-back path (a plain copy); dropping alpha here is cheaper than
+    // letting GL convert to RGB.
+    glReadPixels(0, 0, frame.width, frame.height, GL_RGBA, GL_UNSIGNED_BYTE, read_buffer.data());
+    check("reading back the image");
+
+    for (std::size_t y = 0; y < rows; ++y) {
+      const std::uint8_t* source = read_buffer.data() + 4 * width * (rows - 1 - y);
+      std::uint8_t* target = image.rgb.data() + 3 * width * y;
+      for (std::size_t x = 0; x < width; ++x) {
+        target[3 * x] = source[4 * x];
+        target[3 * x + 1] = source[4 * x + 1];
+        target[3 * x + 2] = source[4 * x + 2];
+      }
+    }
+  } catch (const std::exception& e) {
+    if (failure.empty()) failure = e.what();
+    throw;
+  } catch (...) {
+    if (failure.empty()) failure = "Renderer: unknown error while drawing";
+    throw;
   }
   return image;
 }

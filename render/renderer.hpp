@@ -24,6 +24,14 @@ struct RendererInfo {
 // Renderer must be used from one thread at a time. Framebuffers are allocated on the first
 // render() and reallocated when the frame size changes. Not copyable; movable (a moved-from
 // Renderer may only be destroyed or assigned to).
+//
+// Failures. Input errors (std::invalid_argument) and running out of memory before the first GL
+// call of a frame (std::bad_alloc) leave the renderer usable. A failed GL or OSMesa call (a GL
+// error such as GL_OUT_OF_MEMORY, an incomplete framebuffer, OSMesaMakeCurrent failing) throws
+// std::runtime_error naming the call, and the renderer is then unusable: later render() calls
+// throw, and its destructor makes no further OSMesa call on the failed context (it is abandoned
+// until the process exits rather than released or destroyed, since either would flush whatever
+// the failure left queued). Destroying a Renderer is safe after any failure.
 class Renderer {
  public:
   // Frames up to max_width × max_height pixels can be rendered. `samples` is the requested
