@@ -6,12 +6,19 @@
 
 #include <cstdlib>
 
+#if defined(CLOTHSIM_X86_KERNELS)
+#include <cpuid.h>
+#endif
+
 namespace clothsim::supernodal_avx2 {
 
 #if defined(CLOTHSIM_X86_KERNELS)
 bool supported() {
   __builtin_cpu_init();
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("f16c");
+  // F16C through CPUID leaf 1 (ECX bit 29): clang 14's __builtin_cpu_supports does not know "f16c".
+  unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
+  const bool f16c = __get_cpuid(1, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_F16C) != 0;
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && f16c;
 }
 #else
 bool supported() { return false; }
