@@ -1,4 +1,4 @@
-// Boundary conditions on control vertices (paper §4.4, formulas.md §6).
+// Boundary conditions on control vertices (paper §4.4; docs/formulas.md §4, Borders).
 #pragma once
 
 #include "sim/boundary/motion.hpp"

@@ -1,6 +1,7 @@
 // Displacement of every extended-mesh vertex (real and ghost) as a linear combination of the
 // free real displacement components (paper §4.4: ghost vertices and boundary conditions are
-// folded into the element matrices, so the system stays symmetric; formulas.md §6).
+// folded into the element matrices, so the system stays symmetric; docs/formulas.md §4,
+// Borders).
 //
 // Rules (u(g') is the displacement interpolated at the mirror image g' of ghost g across its
 // border edge (a, b), e its foot on the edge, c the real vertex opposite the edge):

@@ -1,5 +1,5 @@
 // The linear Kirchhoff–Love subdivision shell element (Cirak et al. 2000 eqs. 21–22; paper
-// §4.2 eqs. 24–27; formulas.md §4–5).
+// §4.2 eqs. 24–27; docs/formulas.md §5 Kirchhoff–Love strains, §6 Material law).
 //
 // At a point of an element with patch vertices I = 0 .. n−1 (basis rows from patch.hpp) and
 // rest positions X_I, the linearised membrane and bending strains in Voigt order
@@ -34,7 +34,8 @@ struct SurfacePoint {
 
 SurfacePoint surface_point(const BasisMatrix& basis, const Eigen::MatrixX3d& x);
 
-// Isotropic constitutive matrix in Voigt form in the curvilinear frame (formulas.md §5).
+// Isotropic constitutive matrix in Voigt form in the curvilinear frame (docs/formulas.md §6,
+// Material law).
 Eigen::Matrix3d material_matrix(const SurfacePoint& s, double poisson_ratio);
 
 // Strain–displacement matrices (3 × 3n) of the linearised membrane and bending strains.

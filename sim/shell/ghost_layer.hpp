@@ -1,4 +1,5 @@
-// The ghost-vertex layer at borders (paper §4.4; Cirak et al. 2000 §4.4; formulas.md §6).
+// The ghost-vertex layer at borders (paper §4.4; Cirak et al. 2000 §4.4; docs/formulas.md §4,
+// Borders).
 //
 // Outside each border edge (a, b) of the triangle (a, b, c) sits one ghost vertex g with rest
 // position x_g = x_a + x_b − x_c (the free-edge rule), joined by the ghost triangle (b, a, g);

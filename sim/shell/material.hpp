@@ -1,6 +1,6 @@
-// Material of a Kirchhoff–Love shell (paper §3.2, eq. 17; formulas.md §5): isotropic, linear,
-// with membrane (stretch) stiffness and bending rigidity set independently, as measured fabrics
-// do not obey D = E t³ / 12.
+// Material of a Kirchhoff–Love shell (paper §3.2, eq. 17; docs/formulas.md §6, Material law):
+// isotropic, linear, with membrane (stretch) stiffness and bending rigidity set independently, as
+// measured fabrics do not obey D = E t³ / 12.
 #pragma once
 
 #include <string>

@@ -1,7 +1,7 @@
-// Square Kirchhoff plates with analytic centre deflections (formulas.md §7; Timoshenko &
-// Woinowsky-Krieger, "Theory of plates and shells", tables for the square plate), built through
-// the public static-analysis API. Shared by the convergence study (sim/study/convergence.hpp),
-// the plate tests and bench/plate_convergence.
+// Square Kirchhoff plates with analytic centre deflections (docs/formulas.md §9, Analytic
+// references; Timoshenko & Woinowsky-Krieger, "Theory of plates and shells", tables for the
+// square plate), built through the public static-analysis API. Shared by the convergence study
+// (sim/study/convergence.hpp), the plate tests and bench/plate_convergence.
 //
 // The plate: side a [m] centred at the origin in the z = 0 plane, E = 1e7 Pa, ν = 0.3,
 // t = 0.01 m, all four edges hinged (simply supported) or clamped; loaded by a uniform
@@ -33,7 +33,8 @@ struct AnalyticPlate {
   constexpr double relative_precision() const { return 0.5 * last_digit / coefficient; }
 };
 
-// Simply supported / clamped × uniform / point load, in that order (coefficients: formulas.md §7).
+// Simply supported / clamped × uniform / point load, in that order (coefficients:
+// docs/formulas.md §9, Analytic references).
 // The clamped point-load coefficient has 4 digits only (± 9e-5 relative): finer errors than that
 // cannot be told apart from the reference's rounding.
 inline constexpr std::array<AnalyticPlate, 4> kAnalyticPlates{{

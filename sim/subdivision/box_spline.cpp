@@ -12,7 +12,8 @@ struct Term {
   int a, b, c;
 };
 
-// formulas.md §2 (Cirak et al. 2000, appendix A.1), before the common factor 1/12.
+// docs/formulas.md §2, Regular patches (Cirak et al. 2000, appendix A.1), before the common
+// factor 1/12.
 const std::array<std::vector<Term>, 12>& polynomials() {
   static const std::array<std::vector<Term>, 12> p = {{
       {{1, 4, 0, 0}, {2, 3, 1, 0}},

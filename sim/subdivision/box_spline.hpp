@@ -1,5 +1,6 @@
 // The 12 quartic box-spline basis functions of a regular Loop patch (Stam 1998; Cirak et al.
-// 2000 appendix; formulas.md §2; paper eq. 22) with first and second derivatives.
+// 2000 appendix; docs/formulas.md §2, Regular patches; paper eq. 22) with first and second
+// derivatives.
 //
 // Control-vertex layout (rows of the regular triangular lattice), element = triangle (4, 7, 8):
 //         1   2

@@ -1,5 +1,6 @@
-// Loop subdivision (Loop 1987; formulas.md §1; paper §4.1, Figs. 3–4): vertex and edge masks
-// with Loop's β, limit-position and limit-tangent masks, and one global refinement step.
+// Loop subdivision (Loop 1987; docs/formulas.md §1, Loop subdivision; paper §4.1, Figs. 3–4):
+// vertex and edge masks with Loop's β, limit-position and limit-tangent masks, and one global
+// refinement step.
 #pragma once
 
 #include "sim/mesh/mesh.hpp"

@@ -1,5 +1,5 @@
-// Square and strip plates with analytic solutions (formulas.md §7), built through the public
-// static-analysis API. The definitions live in sim/study/plates.hpp (shared with the convergence
+// Square and strip plates with analytic solutions (docs/formulas.md §9, Analytic references),
+// built through the public static-analysis API. The definitions live in sim/study/plates.hpp (shared with the convergence
 // study and bench/plate_convergence); this header keeps the tests' clothsim::testing names.
 #pragma once
 

@@ -1,6 +1,7 @@
 // Large rotations: a clamped strip under a follower end moment M, run to rest, against the
-// exact (inextensible) solution (formulas.md §7): a circular arc of curvature κ = M/EI, tip
-// rotation θ = ML/EI, tip at x = (L/θ) sin θ, w = (L/θ)(1 − cos θ) from the clamp.
+// exact (inextensible) solution (docs/formulas.md §9, Analytic references): a circular arc of
+// curvature κ = M/EI, tip rotation θ = ML/EI, tip at x = (L/θ) sin θ, w = (L/θ)(1 − cos θ) from
+// the clamp.
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/generators.hpp"
 

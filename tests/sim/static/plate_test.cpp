@@ -1,6 +1,6 @@
-// Linear static analysis against Kirchhoff plate theory (formulas.md §7): simply supported and
-// clamped square plates under uniform and centre point loads, convergence under refinement,
-// and a cantilever strip's small-deflection tip (P L³ / 3EI).
+// Linear static analysis against Kirchhoff plate theory (docs/formulas.md §9, Analytic
+// references): simply supported and clamped square plates under uniform and centre point loads,
+// convergence under refinement, and a cantilever strip's small-deflection tip (P L³ / 3EI).
 #include "tests/support/plates.hpp"
 
 #include <gtest/gtest.h>
