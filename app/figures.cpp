@@ -3,6 +3,7 @@
 
 #include "app/output_folders.hpp"
 #include "app/plotting.hpp"
+#include "app/resources.hpp"
 #include "app/run.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/scene/scene.hpp"
@@ -23,10 +24,6 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
-
-#ifndef CLOTHSIM_SOURCE_DIR
-#error "CLOTHSIM_SOURCE_DIR must be defined (app/CMakeLists.txt)"
-#endif
 
 namespace clothsim {
 
@@ -381,7 +378,7 @@ int run_figures(const FiguresOptions& options) {
     std::map<std::string, double> needed;
     for (const FigureSpec& f : wanted)
       for (const PanelSpec& p : f.panels) needed[p.run] = std::max(needed[p.run], p.time);
-    const fs::path scenes_dir = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
+    const fs::path scenes_dir = resource_dir("scenes");
     std::map<std::string, PreparedRun> runs;
     for (const RunSpec& spec : run_specs())
       if (needed.count(spec.id)) runs.emplace(spec.id, prepare(spec, scenes_dir, needed[spec.id]));

@@ -1,20 +1,18 @@
 #include "app/plotting.hpp"
 
+#include "app/resources.hpp"
+
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 
-#ifndef CLOTHSIM_SOURCE_DIR
-#error "CLOTHSIM_SOURCE_DIR must be defined (app/CMakeLists.txt)"
-#endif
-
 namespace clothsim {
 
 std::string run_plot_script(const std::string& script, const std::vector<std::string>& args) {
   const std::string python = "/usr/bin/python3";
-  const std::filesystem::path path = std::filesystem::path(CLOTHSIM_SOURCE_DIR) / "scripts" / script;
+  const std::filesystem::path path = resource_dir("scripts") / script;
   std::error_code ec;
   if (!std::filesystem::exists(python, ec))
     return python + " not found; install Debian's python3-matplotlib (scripts/install_deps.sh)";

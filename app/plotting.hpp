@@ -7,9 +7,10 @@
 
 namespace clothsim {
 
-// Runs `/usr/bin/python3 <source dir>/scripts/<script> <args...>` and waits for it. Returns an
-// empty string on success, otherwise a message saying what failed (no python3, matplotlib
-// missing, the script's exit status) and how to fix it.
+// Runs `/usr/bin/python3 <scripts>/<script> <args...>` and waits for it, <scripts> being
+// resource_dir("scripts") (app/resources.hpp). Returns an empty string on success, otherwise a
+// message saying what failed (no python3, matplotlib missing, the script's exit status) and how
+// to fix it.
 std::string run_plot_script(const std::string& script, const std::vector<std::string>& args);
 
 }  // namespace clothsim

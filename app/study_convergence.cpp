@@ -8,6 +8,7 @@
 // older report is replaced only then. If only the plot fails, the folder (with the CSV) is still
 // published and the command exits with 1.
 #include "app/output_folders.hpp"
+#include "app/resources.hpp"
 #include "app/study.hpp"
 #include "sim/study/convergence.hpp"
 #include "sim/study/report_format.hpp"
@@ -19,10 +20,6 @@
 #include <stdexcept>
 #include <sstream>
 #include <string>
-
-#ifndef CLOTHSIM_SOURCE_DIR
-#error "CLOTHSIM_SOURCE_DIR must be defined (app/CMakeLists.txt)"
-#endif
 
 namespace clothsim {
 
@@ -43,7 +40,7 @@ int run_convergence_study(const StudyOptions& options) {
   const fs::path target = options.out_root / "study_convergence";
   try {
     const auto start = std::chrono::steady_clock::now();
-    const fs::path scenes = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
+    const fs::path scenes = resource_dir("scenes");
     const ConvergencePlan plan = options.quick ? quick_convergence_plan(scenes) : full_convergence_plan(scenes);
     const std::vector<ConvergenceRow> rows = run_convergence(plan, convergence_methods(), [](const std::string& line) {
       std::cerr << "clothsim: convergence: " << line << std::endl;

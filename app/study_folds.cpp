@@ -9,6 +9,7 @@
 // report is replaced only then. A run that fails is a row with a note, not the end of the study.
 // If only the plot fails, the folder (with the CSV) is still published and the command exits 1.
 #include "app/output_folders.hpp"
+#include "app/resources.hpp"
 #include "app/study.hpp"
 #include "sim/study/fold_study.hpp"
 #include "sim/study/report_format.hpp"
@@ -20,10 +21,6 @@
 #include <stdexcept>
 #include <string>
 
-#ifndef CLOTHSIM_SOURCE_DIR
-#error "CLOTHSIM_SOURCE_DIR must be defined (app/CMakeLists.txt)"
-#endif
-
 namespace clothsim {
 
 int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args) {
@@ -32,7 +29,7 @@ int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args
   FoldStudyPlan plan;
   try {
     // The plan and its options: a bad option is reported before anything runs or is written.
-    const fs::path scenes = fs::path(CLOTHSIM_SOURCE_DIR) / "scenes";
+    const fs::path scenes = resource_dir("scenes");
     plan = options.quick ? quick_fold_plan(scenes) : full_fold_plan(scenes);
     if (!args.meshes.empty()) plan.meshes = parse_fold_meshes(args.meshes);
     if (!args.seeds.empty()) plan.seeds = parse_fold_seeds(args.seeds);
