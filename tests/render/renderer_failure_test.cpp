@@ -75,11 +75,12 @@ void expect(bool condition, const std::string& what) {
   std::exit(1);
 }
 
-// RLIMIT_AS cannot be used under AddressSanitizer (its shadow memory reserves terabytes).
-#if defined(__SANITIZE_ADDRESS__)
+// RLIMIT_AS cannot be used under the address, thread or memory sanitizers (their shadow memory
+// reserves terabytes of address space).
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
 constexpr bool kAddressSpaceCapWorks = false;
 #elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
 constexpr bool kAddressSpaceCapWorks = false;
 #else
 constexpr bool kAddressSpaceCapWorks = true;
@@ -104,7 +105,7 @@ TEST(RendererFailure, SizeBeyondTheGlLimitIsAClearErrorAndLeavesRenderingUsable)
 }
 
 TEST(RendererFailure, OutOfMemoryBeforeDrawingLeavesTheRendererUsable) {
-  if (!kAddressSpaceCapWorks) GTEST_SKIP() << "address-space caps do not work under AddressSanitizer";
+  if (!kAddressSpaceCapWorks) GTEST_SKIP() << "address-space caps do not work under this sanitizer";
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_EXIT(child([] {
                 Renderer renderer(256, 256);
@@ -134,7 +135,7 @@ TEST(RendererFailure, OutOfMemoryBeforeDrawingLeavesTheRendererUsable) {
 }
 
 TEST(RendererFailure, FramebufferOutOfMemoryIsAClearErrorAndTeardownIsSafe) {
-  if (!kAddressSpaceCapWorks) GTEST_SKIP() << "address-space caps do not work under AddressSanitizer";
+  if (!kAddressSpaceCapWorks) GTEST_SKIP() << "address-space caps do not work under this sanitizer";
   GTEST_FLAG_SET(death_test_style, "threadsafe");
   EXPECT_EXIT(child([] {
                 {
