@@ -144,12 +144,17 @@ int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "figures") return figures_command(argc, argv);
   CLI::App app{
       "clothsim: Kirchhoff-Love thin-shell cloth simulator on Loop-subdivision surfaces.\n"
-      "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes\n"
-      "its results to DIR/<scene name>/: result.json and limit.obj for a static scene;\n"
+      "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes its\n"
+      "results to DIR/<scene name>/: result.json, limit.obj and limit.png for a static scene;\n"
       "probes.csv, stats.csv, summary.json, frame_NNNN.png and (with output.obj) frames/ for a\n"
-      "dynamic one. `clothsim render DIR` draws a run's saved frames/mesh_*.obj again;\n"
-      "`clothsim study convergence|stability|folds` writes the reports of README.md, \"Studies\";\n"
-      "`clothsim figures [N ...]` reproduces the paper's Figs. 1 and 7-11 (docs/figures.md).",
+      "dynamic one. With --no-render no PNG is written.\n"
+      "\n"
+      "Other commands (each has its own --help):\n"
+      "  clothsim render DIR                         draw a run's saved geometry again\n"
+      "  clothsim compare A B                        compare two PNGs, or two folders' PNGs\n"
+      "  clothsim golden check|update MANIFEST       check or rewrite golden images of scenes\n"
+      "  clothsim study convergence|stability|folds  write a report of README.md, \"Studies\"\n"
+      "  clothsim figures [N ...]                    the paper's Figs. 1, 7-11 (docs/figures.md)\n",
       "clothsim"};
   std::string scene;
   std::string out = "out";
