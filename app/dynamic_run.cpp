@@ -4,6 +4,7 @@
 // atomically). The Simulator is used in this file only.
 #include "app/dynamic_run.hpp"
 
+#include "app/checkpoint.hpp"
 #include "app/frame_images.hpp"
 #include "app/limit_surface_drawer.hpp"
 #include "app/output_folders.hpp"
@@ -14,10 +15,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
+#include <csignal>
 #include <chrono>
 #include <cstdlib>
 #include <cmath>
@@ -27,6 +30,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -71,18 +75,35 @@ std::string csv_field(const std::string& s) {
 // A text file written line by line and flushed on demand; every failure throws naming the file.
 class StreamFile {
  public:
-  explicit StreamFile(fs::path path) : path_(std::move(path)), out_(path_, std::ios::binary) {
+  // `append`: continue the file (a resumed run), else start it afresh.
+  StreamFile(fs::path path, bool append)
+      : path_(std::move(path)), out_(path_, std::ios::binary | (append ? std::ios::app : std::ios::trunc)) {
     if (!out_) throw std::runtime_error(path_.string() + ": cannot open the file for writing");
+    out_.seekp(0, std::ios::end);
+    good_bytes_ = static_cast<std::uintmax_t>(out_.tellp());
   }
   void line(const std::string& text) { out_ << text << '\n'; }
+  // Writes the lines so far; if that fails (a full disk), cuts the file back to the last whole
+  // flush, so that it never ends in part of a row, and throws naming the file.
   void flush() {
     out_.flush();
-    if (!out_) throw std::runtime_error(path_.string() + ": cannot write the file");
+    if (!out_) {
+      std::error_code ec;
+      fs::resize_file(path_, good_bytes_, ec);
+      throw std::runtime_error(path_.string() + ": cannot write the file" + (ec ? "" : " (cut back to its last whole row)"));
+    }
+    good_bytes_ = static_cast<std::uintmax_t>(out_.tellp());
+  }
+  // The file's length after a flush [bytes].
+  std::uintmax_t bytes() {
+    flush();
+    return good_bytes_;
   }
 
  private:
   fs::path path_;
   std::ofstream out_;
+  std::uintmax_t good_bytes_ = 0;
 };
 
 // Creates a fresh, empty `root/<name>`. An older folder of that name is first renamed to
@@ -127,17 +148,6 @@ std::vector<std::string> settings_warnings(const Scene& scene, int steps) {
   return warnings;
 }
 
-// Running totals for summary.json.
-struct RunTotals {
-  int steps = 0;
-  double t = 0.0;
-  double rotate_ms = 0.0, assemble_ms = 0.0, solve_ms = 0.0;
-  int frames = 0;
-  int max_solver_iterations = 0;
-  long long contact_pairs = 0, contact_impulses = 0, impact_zones = 0, contact_unresolved = 0;
-  long long contact_response_iterations = 0, contact_cg_iterations = 0;
-  double contact_ms = 0.0, contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;
-};
 
 std::string summary_json(const Scene& scene, const RunTotals& totals, double wall_seconds,
                          const std::vector<std::string>& warnings, const std::string& status,
@@ -175,8 +185,10 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
 class Outputs {
  public:
   // `images`: the PNG frames, or null for none.
-  Outputs(const Scene& scene, const fs::path& dir, FrameImages* images)
-      : scene_(scene), dir_(dir), images_(images), probes_(dir / "probes.csv"), stats_(dir / "stats.csv") {
+  // `resume`: continue the CSV files of a resumed run (already cut to the checkpoint's lengths).
+  Outputs(const Scene& scene, const fs::path& dir, FrameImages* images, bool resume)
+      : scene_(scene), dir_(dir), images_(images), probes_(dir / "probes.csv", resume), stats_(dir / "stats.csv", resume) {
+    if (resume) return;
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms") +
                 (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations" : ""));
@@ -259,6 +271,9 @@ class Outputs {
     stats_.flush();
   }
 
+  std::uintmax_t probes_bytes() { return probes_.bytes(); }
+  std::uintmax_t stats_bytes() { return stats_.bytes(); }
+
  private:
   const Scene& scene_;
   fs::path dir_;
@@ -270,14 +285,21 @@ class Outputs {
   StreamFile stats_;
 };
 
-// Progress on stderr: a bar redrawn in place on a terminal, plain lines every 10 % otherwise.
+// Progress on stderr: a bar redrawn in place on a terminal, plain lines every 10 % otherwise. The
+// ETA extrapolates the wall time per step of this session (a resumed run counts from its first
+// step) and adds the pictures still to draw after the run (sequence framing).
 class Progress {
  public:
-  Progress(int steps, double fps) : steps_(steps), fps_(fps), terminal_(::isatty(2) != 0) {}
+  // `first_step`: the step the session starts from; `render_seconds_per_frame`: the time to draw
+  // one picture after the run (0 when pictures are drawn during the run).
+  Progress(int steps, double fps, int first_step, double render_seconds_per_frame)
+      : steps_(steps), first_(first_step), fps_(fps), render_per_frame_(render_seconds_per_frame),
+        terminal_(::isatty(2) != 0) {}
   void update(int step, double t, int frames, double wall) {
     const double done = static_cast<double>(step) / steps_;
-    const double eta = step > 0 ? wall * (1.0 / done - 1.0) : 0.0;
     const int total_frames = static_cast<int>(std::floor(t / std::max(done, 1e-12) * fps_ + 1e-9)) + 1;
+    const double eta = (step > first_ ? wall / (step - first_) * (steps_ - step) : 0.0) +
+                       render_per_frame_ * total_frames;
     char text[160];
     if (terminal_) {
       const int width = 30, filled = static_cast<int>(done * width);
@@ -295,17 +317,49 @@ class Progress {
   }
 
  private:
-  int steps_;
-  double fps_;
+  int steps_, first_;
+  double fps_, render_per_frame_;
   bool terminal_;
+};
+
+// SIGINT and SIGTERM during the steps: the first one asks the run to stop after the current step
+// (it then writes a checkpoint and marks itself "interrupted"); a second one ends the process at
+// once, as without the handler.
+volatile std::sig_atomic_t g_interrupt = 0;
+
+extern "C" void on_interrupt(int signal_number) {
+  if (g_interrupt != 0) {
+    std::signal(signal_number, SIG_DFL);
+    std::raise(signal_number);
+    return;
+  }
+  g_interrupt = signal_number;
+}
+
+class InterruptHandlers {
+ public:
+  InterruptHandlers() {
+    g_interrupt = 0;
+    struct sigaction action {};
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESTART;
+    ::sigaction(SIGINT, &action, &old_int_);
+    ::sigaction(SIGTERM, &action, &old_term_);
+  }
+  ~InterruptHandlers() {
+    ::sigaction(SIGINT, &old_int_, nullptr);
+    ::sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  InterruptHandlers(const InterruptHandlers&) = delete;
+  InterruptHandlers& operator=(const InterruptHandlers&) = delete;
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
 };
 
 // DIR/<name>.mp4 from frame_%04d.png with ffmpeg, if it is installed (a warning otherwise).
 void encode_video(const fs::path& dir, const std::string& name, double fps) {
-  if (std::system("command -v ffmpeg > /dev/null 2>&1") != 0) {
-    log_line("warning: --video: ffmpeg is not installed; no video written");
-    return;
-  }
   char rate[32];
   std::snprintf(rate, sizeof(rate), "%.6g", fps);
   const std::string command = "ffmpeg -loglevel error -y -framerate " + std::string(rate) + " -i '" +
@@ -341,14 +395,43 @@ void print_summary(const Scene& scene, const Simulator& sim, const RunTotals& to
 
 }  // namespace
 
-int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_frames, bool video) {
+int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const DynamicRunOptions& options) {
   const std::string file = scene.file.string();
   const Clock::time_point start = Clock::now();
+  const bool render_frames = options.render;
+  const std::string folder = options.folder.empty() ? scene.name : options.folder;
+  const fs::path run_dir = out_root / folder;
+  if (options.video && std::system("command -v ffmpeg > /dev/null 2>&1") != 0)
+    throw std::runtime_error("--video: ffmpeg is not installed (Debian: apt install ffmpeg); nothing was run");
+  if (options.video && !render_frames) throw std::runtime_error("--video: needs the PNG frames (drop --no-render)");
+
+  // A resumed run: its checkpoint, checked against the scene and options before anything changes.
+  std::optional<RunCheckpoint> resume;
+  if (options.resume) {
+    const fs::path path = run_dir / "checkpoint.bin";
+    if (!fs::exists(path)) {
+      std::string why = "no checkpoint to resume from";
+      try {
+        const auto summary = nlohmann::json::parse(read_text_file(run_dir / "summary.json"));
+        if (summary.value("status", "") == "completed") why = "the run is complete; nothing to resume";
+      } catch (const std::exception&) {
+      }
+      throw std::runtime_error("--resume " + run_dir.string() + ": " + why +
+                               " (checkpoints are written every output.checkpoint_every frames and when a run is "
+                               "interrupted with Ctrl-C or SIGTERM)");
+    }
+    resume = read_checkpoint(path);
+    if (resume->fingerprint != options.fingerprint)
+      throw std::runtime_error("--resume " + run_dir.string() + ": the checkpoint was written for another scene or " +
+                               "other options; resume with the same scene file (unchanged) and the same options "
+                               "(--end, --frames, --size, --framing, --no-render, --set)");
+  }
 
   // Everything that can fail before the first step fails here, before any file is written.
   std::unique_ptr<Simulator> sim;
   try {
     sim = std::make_unique<Simulator>(scene.problem);
+    if (resume) sim->restore(resume->sim);
   } catch (const std::exception& e) {
     throw std::runtime_error(file + ": cannot set up the dynamic analysis: " + e.what());
   }
@@ -356,103 +439,214 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, bool render_
   std::unique_ptr<LimitSurfaceDrawer> drawer;
   std::unique_ptr<render::Renderer> renderer;
   Bounds motion_bounds;  // motion framing: the box framed by the camera
+  double render_seconds_per_frame = 0.0;  // sequence framing: for the ETA
   if (render_frames) {
     try {
       drawer = std::make_unique<LimitSurfaceDrawer>(sim->discretization(), scene.render, scene.render.width,
                                                     scene.render.height);
       drawer->set_obstacles(scene.problem.obstacles);
       renderer = std::make_unique<render::Renderer>(scene.render.width, scene.render.height);
-      if (scene.render.framing == Framing::motion)
+      if (scene.render.framing == Framing::motion) {
         motion_bounds = motion_framing_bounds(*drawer, sim->discretization().rest(), scene.problem);
+      } else {  // one picture of the rest shape, timed, for the ETA of the pictures drawn after the run
+        const Clock::time_point t0 = Clock::now();
+        const SurfaceSnapshot rest = drawer->snapshot(sim->discretization().rest());
+        Bounds b;
+        LimitSurfaceDrawer::extend_bounds(rest, b.lo, b.hi);
+        (void)renderer->render(drawer->frame(rest, drawer->camera(b.lo, b.hi), b.lo[1]));
+        render_seconds_per_frame = seconds_since(t0);
+      }
     } catch (const std::exception& e) {
       throw std::runtime_error(file + ": cannot set up rendering: " + e.what() + " (use --no-render to skip images)");
     }
   }
   const int steps = sim->num_steps();
+  const int first_step = resume ? resume->sim.state.step : 0;
+  if (first_step > steps)
+    throw std::runtime_error("--resume " + run_dir.string() + ": the checkpoint is at step " +
+                             std::to_string(first_step) + ", beyond the run's " + std::to_string(steps) + " steps");
   const std::vector<std::string> warnings = settings_warnings(scene, steps);
   for (const std::string& w : warnings) log_line("warning: " + w);
-  log_line("dynamic analysis: " + std::to_string(steps) + " steps of dt = " + format_short(scene.problem.time.dt) +
-           " s to t = " + format_short(scene.problem.time.end) + " s");
+  if (resume)
+    log_line("resuming " + run_dir.string() + " at step " + std::to_string(first_step) + " (t = " +
+             format_short(resume->sim.state.t) + " s) of " + std::to_string(steps));
+  else
+    log_line("dynamic analysis: " + std::to_string(steps) + " steps of dt = " + format_short(scene.problem.time.dt) +
+             " s to t = " + format_short(scene.problem.time.end) + " s");
 
   fs::path dir;
-  try {
-    dir = create_output_folder(out_root, scene.name);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("cannot create the output folder " + (out_root / scene.name).string() + ": " + e.what());
+  if (resume) {
+    // Back to the checkpoint: the CSV files cut to its lengths, later frames and leftovers removed.
+    dir = run_dir;
+    try {
+      for (const auto& [name, bytes] : {std::pair{"probes.csv", resume->probes_bytes}, {"stats.csv", resume->stats_bytes}}) {
+        if (fs::file_size(dir / name) < bytes)
+          throw std::runtime_error((dir / name).string() + " is shorter than the checkpoint says");
+        fs::resize_file(dir / name, bytes);
+      }
+      const int frames = resume->totals.frames;
+      auto remove_from = [](const fs::path& folder_path, const std::string& prefix, const std::string& extension, int first) {
+        std::error_code ec;
+        for (const auto& entry : fs::directory_iterator(folder_path, ec)) {
+          const std::string name = entry.path().filename().string();
+          if (name.rfind(prefix, 0) != 0 || entry.path().extension() != extension) continue;
+          const std::string number = name.substr(prefix.size(), name.size() - prefix.size() - extension.size());
+          if (!number.empty() && number.find_first_not_of("0123456789") == std::string::npos && std::stoi(number) >= first)
+            fs::remove(entry.path());
+        }
+      };
+      remove_from(dir, "frame_", ".png", render_frames && scene.render.framing == Framing::motion ? resume->images_written : 0);
+      if (scene.write_obj_frames) {
+        fs::create_directories(dir / "frames");
+        remove_from(dir / "frames", "mesh_", ".obj", frames);
+        remove_temporary_files(dir / "frames");
+      }
+      remove_temporary_files(dir);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("--resume " + run_dir.string() + ": cannot go back to the checkpoint: " + e.what());
+    }
+  } else {
+    try {
+      dir = create_output_folder(out_root, folder);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("cannot create the output folder " + run_dir.string() + ": " + e.what());
+    }
   }
 
-  RunTotals totals;
+  RunTotals totals = resume ? resume->totals : RunTotals{};
+  const double wall_before = resume ? resume->wall_seconds : 0.0;
+  auto wall = [&] { return wall_before + seconds_since(start); };
   std::string failure;  // the error message of a failed run
+  int interrupted = 0;  // the signal that interrupted the run
   std::unique_ptr<FrameImages> images;
   std::unique_ptr<Outputs> outputs;
-  try {
-    write_atomically(dir / "summary.json", summary_json(scene, totals, seconds_since(start), warnings, "running", ""));
-    if (drawer)
-      images = std::make_unique<FrameImages>(*drawer, *renderer, scene.render.framing, motion_bounds, dir);
-    outputs = std::make_unique<Outputs>(scene, dir, images.get());
-    outputs->record_state(*sim, 0, sim->state().t, totals);
-    Progress progress(steps, scene.problem.time.output_fps);
-    for (int k = 1; k <= steps; ++k) {
-      try {
-        const StepStats s = sim->step();
-        totals.steps = s.step;
-        totals.t = s.t;
-        totals.rotate_ms += s.rotate_ms;
-        totals.assemble_ms += s.assemble_ms;
-        totals.solve_ms += s.solve_ms;
-        totals.max_solver_iterations = std::max(totals.max_solver_iterations, s.solver_iterations);
-        totals.contact_pairs += s.contact_pairs;
-        totals.contact_impulses += s.contact_impulses;
-        totals.impact_zones += s.impact_zones;
-        totals.contact_unresolved += s.contact_unresolved;
-        totals.contact_ms += s.contact_ms;
-        totals.contact_broad_ms += s.contact_broad_ms;
-        totals.contact_narrow_ms += s.contact_narrow_ms;
-        totals.contact_response_ms += s.contact_response_ms;
-        totals.contact_response_iterations += s.contact_response_iterations;
-        totals.contact_cg_iterations += s.contact_cg_iterations;
-        outputs->record_stats(s);
-        outputs->record_state(*sim, s.step, s.t, totals);
-      } catch (const SimulationError&) {
-        throw;
-      } catch (const std::exception& e) {
-        // Name the step for any other failure (write errors, solver exceptions), as SimulationError does.
-        throw SimulationError(k, k * scene.problem.time.dt, e.what());
+  const fs::path checkpoint_path = dir / "checkpoint.bin";
+  auto write_run_checkpoint = [&] {
+    RunCheckpoint c;
+    c.fingerprint = options.fingerprint;
+    c.sim = sim->checkpoint();
+    c.totals = totals;
+    c.wall_seconds = wall();
+    c.probes_bytes = outputs->probes_bytes();
+    c.stats_bytes = outputs->stats_bytes();
+    if (images) {
+      const FrameResume r = images->resume_point();
+      c.images_written = r.written;
+      c.spool_bytes = r.spool_bytes;
+      for (int k = 0; k < 3; ++k) {
+        c.bounds_lo[k] = r.bounds.lo[k];
+        c.bounds_hi[k] = r.bounds.hi[k];
       }
-      progress.update(k, totals.t, totals.frames, seconds_since(start));
     }
-  } catch (const std::exception& e) {
-    failure = e.what();
+    write_checkpoint(checkpoint_path, c);
+  };
+  const InterruptHandlers handlers;  // until the summary is written
+  {
+    try {
+      // The "running" summary is padded with spaces, so that the final one can still be written
+      // over it in place if the disk fills up (overwrite_in_place).
+      write_atomically(dir / "summary.json", summary_json(scene, totals, wall(), warnings, "running", "") +
+                                                 std::string(4096, ' ') + "\n");
+      if (drawer) {
+        FrameResume r;
+        if (resume) {
+          r.frames = resume->totals.frames;
+          r.written = resume->images_written;
+          for (int k = 0; k < 3; ++k) {
+            r.bounds.lo[k] = resume->bounds_lo[k];
+            r.bounds.hi[k] = resume->bounds_hi[k];
+          }
+          r.spool_bytes = resume->spool_bytes;
+          r.state_size = sim->state().x.size();
+        }
+        images = std::make_unique<FrameImages>(*drawer, *renderer, scene.render.framing, motion_bounds, dir,
+                                               resume ? &r : nullptr);
+      }
+      outputs = std::make_unique<Outputs>(scene, dir, images.get(), resume.has_value());
+      if (!resume) outputs->record_state(*sim, 0, sim->state().t, totals);
+      Progress progress(steps, scene.problem.time.output_fps, first_step, render_seconds_per_frame);
+      for (int k = first_step + 1; k <= steps; ++k) {
+        try {
+          const StepStats s = sim->step();
+          totals.steps = s.step;
+          totals.t = s.t;
+          totals.rotate_ms += s.rotate_ms;
+          totals.assemble_ms += s.assemble_ms;
+          totals.solve_ms += s.solve_ms;
+          totals.max_solver_iterations = std::max(totals.max_solver_iterations, s.solver_iterations);
+          totals.contact_pairs += s.contact_pairs;
+          totals.contact_impulses += s.contact_impulses;
+          totals.impact_zones += s.impact_zones;
+          totals.contact_unresolved += s.contact_unresolved;
+          totals.contact_ms += s.contact_ms;
+          totals.contact_broad_ms += s.contact_broad_ms;
+          totals.contact_narrow_ms += s.contact_narrow_ms;
+          totals.contact_response_ms += s.contact_response_ms;
+          totals.contact_response_iterations += s.contact_response_iterations;
+          totals.contact_cg_iterations += s.contact_cg_iterations;
+          const int frames_before = totals.frames;
+          outputs->record_stats(s);
+          outputs->record_state(*sim, s.step, s.t, totals);
+          const int every = scene.checkpoint_every;
+          const bool checkpoint_due = every > 0 && totals.frames / every > frames_before / every && k < steps;
+          if (g_interrupt != 0 && k < steps) interrupted = g_interrupt;
+          if (checkpoint_due || interrupted != 0) write_run_checkpoint();
+        } catch (const SimulationError&) {
+          throw;
+        } catch (const std::exception& e) {
+          // Name the step for any other failure (write errors, solver exceptions), as SimulationError does.
+          throw SimulationError(k, k * scene.problem.time.dt, e.what());
+        }
+        progress.update(k, totals.t, totals.frames, wall() - wall_before);
+        if (interrupted != 0) break;
+      }
+    } catch (const std::exception& e) {
+      failure = e.what();
+    }
   }
 
-  // Sequence framing: the images of the frames simulated so far (also after a failure), with one
-  // camera for all; motion framing has written them already.
+  // Sequence framing: the images of the frames simulated so far (also after a failure or an
+  // interruption, keeping the spool for --resume then), with one camera for all; motion framing
+  // has written them already.
   if (images) {
     try {
-      const int written = images->finish();
+      const int written = images->finish(/*keep_spool=*/interrupted != 0);
       log_line(std::string(scene.render.framing == Framing::motion ? "wrote " : "rendered ") +
                std::to_string(written) + " frame(s) of " + std::to_string(drawer->fine_triangles()) +
                " triangles to " + (dir / "frame_*.png").string());
-      if (video && written > 0) encode_video(dir, scene.name, scene.problem.time.output_fps);
+      if (options.video && written > 0 && interrupted == 0) encode_video(dir, scene.name, scene.problem.time.output_fps);
     } catch (const std::exception& e) {
       if (failure.empty()) failure = std::string("rendering failed: ") + e.what();
       else log_line("warning: rendering failed: " + std::string(e.what()));
     }
   }
-  const double wall = seconds_since(start);
+  const std::string status = !failure.empty() ? "failed" : interrupted != 0 ? "interrupted" : "completed";
+  const std::string summary = summary_json(scene, totals, wall(), warnings, status, failure);
   try {
-    write_atomically(dir / "summary.json", summary_json(scene, totals, wall, warnings,
-                                                        failure.empty() ? "completed" : "failed", failure));
+    write_atomically(dir / "summary.json", summary);
   } catch (const std::exception& e) {
-    if (failure.empty()) failure = e.what();
-    else log_line("warning: " + std::string(e.what()));
+    // A full disk: the padded "running" summary is rewritten in place instead.
+    if (!overwrite_in_place(dir / "summary.json", summary)) {
+      if (failure.empty()) failure = e.what();
+      else log_line("warning: " + std::string(e.what()));
+    }
+  }
+  if (status == "completed") {
+    std::error_code ec;
+    fs::remove(checkpoint_path, ec);  // nothing left to resume
   }
   if (!failure.empty()) {
     std::cerr << "clothsim: error: " << file << ": " << failure << '\n';
     log_line("kept the outputs written so far in " + dir.string());
     return 1;
   }
-  print_summary(scene, *sim, totals, wall, dir);
+  if (interrupted != 0) {
+    log_line(std::string(interrupted == SIGINT ? "interrupted (SIGINT)" : "interrupted (SIGTERM)") + " after step " +
+             std::to_string(totals.steps) + " (t = " + format_short(totals.t) + " s); wrote " +
+             checkpoint_path.string() + (options.resume_command.empty() ? "" : "; continue with: " + options.resume_command));
+    return 128 + interrupted;
+  }
+  print_summary(scene, *sim, totals, wall(), dir);
   return 0;
 }
 

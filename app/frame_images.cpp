@@ -74,19 +74,58 @@ Bounds motion_framing_bounds(const LimitSurfaceDrawer& drawer, const Eigen::Vect
 fs::path frame_spool_path(const fs::path& dir) { return dir / ".frames.bin"; }
 
 FrameImages::FrameImages(const LimitSurfaceDrawer& drawer, render::Renderer& renderer, Framing framing,
-                         const Bounds& motion_bounds, fs::path dir)
+                         const Bounds& motion_bounds, fs::path dir, const FrameResume* resume)
     : drawer_(drawer), renderer_(renderer), framing_(framing), dir_(std::move(dir)) {
+  if (resume) {
+    frames_ = resume->frames;
+    written_ = resume->written;
+  }
   if (framing_ == Framing::motion) {
     bounds_ = motion_bounds;
     camera_ = drawer_.camera(bounds_.lo, bounds_.hi);
   } else {
-    spool_.open(frame_spool_path(dir_), std::ios::binary | std::ios::trunc);
-    if (!spool_) throw std::runtime_error(frame_spool_path(dir_).string() + ": cannot open the file for writing");
+    const fs::path path = frame_spool_path(dir_);
+    if (resume) {
+      bounds_ = resume->bounds;
+      std::error_code ec;
+      if (fs::file_size(path, ec) < resume->spool_bytes || ec)
+        throw std::runtime_error(path.string() + ": the frame spool is shorter than the checkpoint says (" +
+                                 std::to_string(resume->spool_bytes) + " bytes)");
+      fs::resize_file(path, resume->spool_bytes);
+      spool_.open(path, std::ios::binary | std::ios::app);
+      // The last spooled frame, for a repeat in the first step after resuming.
+      const std::uintmax_t frame_bytes = sizeof(double) * (1 + static_cast<std::uintmax_t>(resume->state_size));
+      if (resume->spool_bytes >= frame_bytes) {
+        std::ifstream in(path, std::ios::binary);
+        in.seekg(static_cast<std::streamoff>(resume->spool_bytes - frame_bytes));
+        last_positions_.resize(resume->state_size);
+        in.read(reinterpret_cast<char*>(&last_time_), sizeof(double));
+        in.read(reinterpret_cast<char*>(last_positions_.data()),
+                static_cast<std::streamsize>(last_positions_.size() * sizeof(double)));
+        if (!in) throw std::runtime_error(path.string() + ": cannot read the last spooled frame");
+      }
+    } else {
+      spool_.open(path, std::ios::binary | std::ios::trunc);
+    }
+    if (!spool_) throw std::runtime_error(path.string() + ": cannot open the file for writing");
   }
 }
 
+FrameResume FrameImages::resume_point() {
+  FrameResume r;
+  r.frames = frames_;
+  r.written = written_;
+  r.bounds = bounds_;
+  if (framing_ == Framing::sequence && spool_.is_open()) {
+    spool_.flush();
+    if (!spool_) throw std::runtime_error(frame_spool_path(dir_).string() + ": cannot write the file");
+    r.spool_bytes = static_cast<std::uintmax_t>(spool_.tellp());
+  }
+  return r;
+}
+
 FrameImages::~FrameImages() {
-  if (framing_ != Framing::sequence) return;
+  if (framing_ != Framing::sequence || keep_spool_) return;
   spool_.close();
   std::error_code ec;
   fs::remove(frame_spool_path(dir_), ec);
@@ -127,8 +166,9 @@ void FrameImages::repeat() {
   ++frames_;
 }
 
-int FrameImages::finish() {
+int FrameImages::finish(bool keep_spool) {
   if (framing_ != Framing::sequence || !spool_.is_open()) return written_;
+  keep_spool_ = keep_spool;
   const fs::path path = frame_spool_path(dir_);
   spool_.close();
   if (!spool_) throw std::runtime_error(path.string() + ": cannot write the file");
@@ -146,6 +186,7 @@ int FrameImages::finish() {
       ++written_;
     }
   }
+  if (keep_spool_) return written_;
   std::error_code ec;
   fs::remove(path, ec);
   if (ec) throw std::runtime_error(path.string() + ": cannot delete the file: " + ec.message());

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include <filesystem>
+#include <cstdint>
 #include <fstream>
 #include <optional>
 
@@ -49,14 +50,25 @@ Bounds motion_framing_bounds(const LimitSurfaceDrawer& drawer, const Eigen::Vect
 // was killed.
 std::filesystem::path frame_spool_path(const std::filesystem::path& dir);
 
+// Where a resumed run's pictures continue (from its checkpoint): frames handed in and pictures
+// written so far, and for sequence framing the bounds of the spooled frames and the spool's length.
+struct FrameResume {
+  int frames = 0;
+  int written = 0;
+  Bounds bounds;
+  std::uintmax_t spool_bytes = 0;
+  Eigen::Index state_size = 0;  // 3·#nodes, the length of a spooled frame's positions
+};
+
 class FrameImages {
  public:
   // Pictures of frames drawn by `drawer` and `renderer` into `dir`. With Framing::motion,
   // `motion_bounds` (motion_framing_bounds) sets the camera, unless the scene has one, and the
-  // ground height; it is ignored with Framing::sequence.
+  // ground height; it is ignored with Framing::sequence. With `resume`, continues a run: the
+  // spool is cut to resume->spool_bytes and appended to.
   FrameImages(const LimitSurfaceDrawer& drawer, render::Renderer& renderer, Framing framing,
-              const Bounds& motion_bounds, std::filesystem::path dir);
-  // Removes the spool file if it is still there.
+              const Bounds& motion_bounds, std::filesystem::path dir, const FrameResume* resume = nullptr);
+  // Removes the spool file if it is still there (unless keep_spool()).
   ~FrameImages();
   FrameImages(const FrameImages&) = delete;
   FrameImages& operator=(const FrameImages&) = delete;
@@ -68,9 +80,12 @@ class FrameImages {
   void repeat();
   // Frames handed in so far.
   int frames() const { return frames_; }
+  // What a checkpoint records to continue from here (spool flushed first).
+  FrameResume resume_point();
   // Sequence framing: draws every spooled frame with one camera framing their bounds and deletes
-  // the spool file. Returns the number of pictures written by this object in all.
-  int finish();
+  // the spool file, or keeps it with `keep_spool` (an interrupted run that may be resumed).
+  // Returns the number of pictures written by this object in all.
+  int finish(bool keep_spool = false);
 
  private:
   void write_picture(const render::Image& image, int frame) const;
@@ -88,6 +103,7 @@ class FrameImages {
   std::ofstream spool_;                      // sequence framing
   int frames_ = 0;
   int written_ = 0;
+  bool keep_spool_ = false;
 };
 
 }  // namespace clothsim

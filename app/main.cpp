@@ -180,8 +180,29 @@ int main(int argc, char** argv) {
                  "'sequence' frames the whole run and writes the PNGs after it (replaces render.framing)")
       ->check(CLI::IsMember({"motion", "sequence"}))
       ->type_name("MODE");
+  std::vector<std::string> overrides;
+  app.add_option("--set", overrides,
+                 "Override a scene key, checked like the file (repeatable): e.g. --set time.end=0.5,\n"
+                 "--set material.preset=black_denim, --set boundary[0].rotation=clamped; VALUE is JSON,\n"
+                 "else a string; null removes the key (scenes/README.md, \"Overrides\")")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  std::string resume;
+  CLI::Option* resume_option =
+      app.add_option("--resume", resume,
+                     "Dynamic scenes: continue the interrupted run in DIR (e.g. out/<name>) from its\n"
+                     "checkpoint.bin, with the same scene and options; the outputs end up byte-identical\n"
+                     "to an uninterrupted run's (timings aside)")
+          ->type_name("DIR");
   if (const int code = parse(app, argc, argv); code >= 0) return code;
   clothsim::RunOptions options;
+  if (resume_option->count() > 0) {
+    if (app.get_option("--out")->count() > 0) {
+      std::cerr << "clothsim: error: --resume DIR names the run's folder; --out cannot be given with it\n";
+      return 1;
+    }
+    options.resume = resume;
+  }
   if (end_option->count() > 0) options.end = end;
   options.render = !no_render;
   options.video = video;

@@ -42,3 +42,44 @@ std::string publish_report(const std::filesystem::path& out_root, const std::str
                            const std::string& png);
 
 }  // namespace clothsim
+
+namespace clothsim {
+
+// Exclusive use of the output folder out_root/<name> by this process: an advisory lock (flock) on
+// the file out_root/.<name>.lock, which holds the PID of its owner. The kernel releases the lock
+// when the owner exits however it exits (even on SIGKILL), so a stale lock file never blocks a
+// later run. The constructor creates out_root if needed (removed again by release() if the run
+// created nothing else there) and throws std::runtime_error naming the folder and the PID of the
+// run that holds it. The destructor removes the lock file.
+class OutputLock {
+ public:
+  OutputLock(const std::filesystem::path& out_root, const std::string& name);
+  ~OutputLock();
+  OutputLock(const OutputLock&) = delete;
+  OutputLock& operator=(const OutputLock&) = delete;
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+};
+
+// Removes what dead runs left in `out_root`: hidden temporary folders and files
+// ".<name>.tmp-<pid>", ".<name>.tmp-<pid>-..." and ".<name>.old-<pid>" whose process <pid> no
+// longer exists (never those of a live process, nor this one's). Returns one line per removed
+// entry for the log. Never throws.
+std::vector<std::string> remove_dead_temporaries(const std::filesystem::path& out_root);
+
+// Removes the hidden temporary files (".*.tmp*") directly in `dir`: for a run folder whose
+// lock this process holds, every such file is a leftover of a killed run. Returns their number.
+int remove_temporary_files(const std::filesystem::path& dir);
+
+// Whether a process with this PID exists (kill(pid, 0) does not fail with ESRCH).
+bool process_alive(long pid);
+
+// Rewrites the existing file `path` in place with `text` followed by spaces up to its old size,
+// without allocating disk space: the fallback for a summary that cannot be replaced through a
+// temporary file because the disk is full. Returns false (and changes nothing) if the file does
+// not exist or is shorter than `text`, or if the write fails.
+bool overwrite_in_place(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace clothsim

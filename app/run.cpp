@@ -3,6 +3,7 @@
 // scenes are handed to run_dynamic_scene (app/dynamic_run.hpp).
 #include "app/run.hpp"
 
+#include "app/checkpoint.hpp"
 #include "app/dynamic_run.hpp"
 #include "app/limit_surface_drawer.hpp"
 #include "app/output_folders.hpp"
@@ -144,6 +145,43 @@ void apply_end_option(Scene& scene, const RunOptions& options) {
     throw std::runtime_error("--end: " + problem);
 }
 
+// `s` as one word for a shell (single-quoted when it holds anything but [A-Za-z0-9_./=-]).
+std::string shell_word(const std::string& s) {
+  if (!s.empty() && s.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_./=-,") ==
+                        std::string::npos)
+    return s;
+  std::string q = "'";
+  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// The options of this run that a resumed run must repeat, as command-line words (for the message
+// of an interrupted run).
+std::string resume_options(const RunOptions& o, const Scene& scene) {
+  std::string words;
+  if (o.end) words += " --end " + shortest(*o.end);
+  if (o.frames) words += " --frames " + std::to_string(*o.frames);
+  if (!o.render) words += " --no-render";
+  if (o.video) words += " --video";
+  if (o.width > 0) words += " --size " + std::to_string(o.width) + "x" + std::to_string(o.height);
+  if (o.framing) words += " --framing " + *o.framing;
+  for (const std::string& set : scene.overrides) words += " --set " + shell_word(set);
+  return words;
+}
+
+// What a checkpoint must have been written for: the scene file's bytes (and the OBJ mesh it
+// names, through the resulting vertex count) and every option that changes the outputs.
+std::uint64_t run_fingerprint(const fs::path& scene_file, const Scene& scene, const RunOptions& o) {
+  std::string text;
+  try {
+    text = read_text_file(scene_file);
+  } catch (const std::exception&) {
+  }
+  std::uint64_t h = fnv1a(text);
+  h = fnv1a(resume_options(o, scene) + "\n" + std::to_string(scene.problem.mesh.num_vertices()), h);
+  return h;
+}
+
 }  // namespace
 
 int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const RunOptions& options) {
@@ -156,7 +194,46 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
     if (options.width > 0) scene.render.width = options.width;
     if (options.height > 0) scene.render.height = options.height;
     if (options.framing) scene.render.framing = *options.framing == "sequence" ? Framing::sequence : Framing::motion;
-    if (scene.analysis == "dynamic") return run_dynamic_scene(scene, out_root, options.render, options.video);
+    // --resume DIR continues the run in DIR (its parent is the output root).
+    fs::path root = out_root;
+    std::string folder = scene.name;
+    if (options.resume) {
+      if (scene.analysis != "dynamic")
+        throw std::runtime_error("--resume: only dynamic runs can be resumed (" + scene.file.string() + " is " +
+                                 scene.analysis + ")");
+      const fs::path dir = fs::path(*options.resume).lexically_normal();
+      if (!fs::is_directory(dir)) throw std::runtime_error("--resume " + options.resume->string() + ": no such folder");
+      root = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+      folder = dir.filename().string();
+      if (folder.empty() || folder == "." || folder == "..")
+        throw std::runtime_error("--resume " + options.resume->string() + ": name the run's folder, e.g. out/" +
+                                 scene.name);
+    }
+    // One run per output folder: a second run of the same name into the same root is refused
+    // while this one lives (the lock goes with the process, however it ends).
+    // Folders the lock creates are removed again when the run leaves nothing in them.
+    struct HeldFolder {
+      std::vector<fs::path> created;
+      std::unique_ptr<OutputLock> lock;
+      ~HeldFolder() {
+        lock.reset();
+        std::error_code ec;
+        for (const fs::path& dir : created) fs::remove(dir, ec);  // deepest first; only if empty
+      }
+    } held{missing_folders(root), nullptr};
+    held.lock = std::make_unique<OutputLock>(root, folder);
+    for (const std::string& line : remove_dead_temporaries(root)) log_line(line);
+    if (scene.analysis == "dynamic") {
+      DynamicRunOptions dynamic;
+      dynamic.render = options.render;
+      dynamic.video = options.video;
+      dynamic.folder = folder;
+      dynamic.resume = options.resume.has_value();
+      dynamic.fingerprint = run_fingerprint(scene_file, scene, options);
+      dynamic.resume_command = "clothsim " + shell_word(scene_file.string()) + resume_options(options, scene) + " --resume " +
+                               shell_word((root / folder).string());
+      return run_dynamic_scene(scene, root, dynamic);
+    }
 
     StaticResult result;
     try {

@@ -16,10 +16,10 @@ struct RunOptions {
   std::optional<int> frames;  // --frames N: simulate just long enough for N frames
   bool video = false;         // --video: also encode DIR/<name>/<name>.mp4 with ffmpeg
   std::optional<std::string> framing;  // --framing motion|sequence: replaces render.framing
+  std::vector<std::string> overrides;  // --set KEY=VALUE, in order: scene keys replaced before the
+                                       // scene is checked (load_scene)
+  std::optional<std::filesystem::path> resume;  // --resume DIR: continue the dynamic run in DIR
 };
-
-// `clothsim render DIR`: draws DIR/frames/mesh_*.obj again into DIR/frame_NNNN.png.
-int render_saved_frames(const std::filesystem::path& dir, int width, int height);
 
 // Loads `scene_file`, runs its analysis and writes `out_root`/<scene name>/, replacing an older
 // folder of that name: result.json and limit.obj for a static scene; probes.csv, stats.csv,

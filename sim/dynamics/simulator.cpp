@@ -13,6 +13,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace clothsim {
 
@@ -172,5 +174,20 @@ double Simulator::max_membrane_strain() const {
   return impl_->discretization->max_membrane_strain(impl_->integrator->displacement());
 }
 const Eigen::VectorXd& Simulator::vertex_mass() const { return impl_->node_mass; }
+
+SimulatorCheckpoint Simulator::checkpoint() const {
+  const Impl& m = *impl_;
+  return {m.state, m.integrator->checkpoint(), m.solver.checkpoint()};
+}
+
+void Simulator::restore(const SimulatorCheckpoint& c) {
+  Impl& m = *impl_;
+  const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(m.discretization->num_nodes());
+  if (c.state.x.size() != n3 || c.state.v.size() != n3 || c.state.step < 0 || !(c.state.t >= 0.0))
+    throw std::invalid_argument("the checkpoint's state does not fit the mesh (" + std::to_string(n3 / 3) + " nodes)");
+  m.state = c.state;
+  m.integrator->restore(m.state, c.integrator);
+  m.solver.restore(c.solver, m.integrator->system_matrix(), m.integrator->free_dofs());
+}
 
 }  // namespace clothsim

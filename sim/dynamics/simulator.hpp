@@ -12,12 +12,22 @@
 
 #include "sim/integrator/implicit_euler.hpp"
 #include "sim/problem/problem.hpp"
+#include "sim/solver/linear_solver.hpp"
 
 #include <Eigen/Core>
 
 #include <memory>
 
 namespace clothsim {
+
+// Everything later steps depend on, so that a run restored from it continues bit for bit as the
+// run it was taken from (the terms and the contact stage keep no state between steps beyond what
+// they recompute from the state).
+struct SimulatorCheckpoint {
+  DynamicState state;
+  IntegratorCheckpoint integrator;
+  LinearSolverCheckpoint solver;
+};
 
 class Simulator {
  public:
@@ -66,6 +76,13 @@ class Simulator {
   double max_membrane_strain() const;
   // Lumped mass per node [kg] (areal density × a third of the incident area).
   const Eigen::VectorXd& vertex_mass() const;
+
+  // The state after the last step, for continuing the run later (restore()).
+  SimulatorCheckpoint checkpoint() const;
+  // Continues from `c`, taken from a Simulator of the same problem: the next step() gives what
+  // the original's next step gave, to the bit. Throws std::invalid_argument if `c` does not fit
+  // the problem (mesh size, solver settings); the Simulator is then unusable.
+  void restore(const SimulatorCheckpoint& c);
 
  private:
   struct Impl;

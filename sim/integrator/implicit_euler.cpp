@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace clothsim {
@@ -52,6 +54,19 @@ ImplicitEuler::ImplicitEuler(const IntegratorSettings& settings, const Discretiz
   diagonal_ = diagonal_offsets(system_);
   u_ = state.x - discretization.rest();
   discretization.make_consistent(u_);
+  update_terms(state.x, u_, state.t);
+}
+
+void ImplicitEuler::restore(const DynamicState& state, const IntegratorCheckpoint& c) {
+  const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(discretization_.num_nodes());
+  if (state.x.size() != n3 || state.v.size() != n3 || c.u.size() != n3 ||
+      (c.v_previous.size() != 0 && c.v_previous.size() != n3))
+    throw std::invalid_argument("ImplicitEuler::restore: the checkpoint's state does not fit the mesh (" +
+                                std::to_string(n3 / 3) + " nodes)");
+  u_ = c.u;
+  v_previous_ = c.v_previous;
+  work_ = c.external_work;
+  boundary_work_ = c.boundary_work;
   update_terms(state.x, u_, state.t);
 }
 

@@ -131,6 +131,14 @@ class SimulationError : public std::runtime_error {
   Kind kind_;
 };
 
+// The integrator's own state beyond DynamicState, for a run continued from a checkpoint: the
+// displacement as the step computed it (x − rest differs from it in the last bits), the previous
+// step's start velocity (the extrapolated start) and the accumulated works [J].
+struct IntegratorCheckpoint {
+  Eigen::VectorXd u, v_previous;
+  double external_work = 0.0, boundary_work = 0.0;
+};
+
 class ImplicitEuler {
  public:
   // `internal`: the cloth's own terms (elastic, damping), whose energies make elastic_energy();
@@ -173,6 +181,12 @@ class ImplicitEuler {
   void set_velocity_filter(VelocityFilter* filter) { filter_ = filter; }
   // Which DOFs are unknowns of the linear solve (3·#nodes): the ones a velocity filter may change.
   const std::vector<char>& free_dofs() const { return free_; }
+  IntegratorCheckpoint checkpoint() const { return {u_, v_previous_, work_, boundary_work_}; }
+  // Continues from `c`, taken at `state`: sets the integrator's state and evaluates the terms at
+  // it, as the step that reached it did. Throws std::invalid_argument on a size mismatch.
+  void restore(const DynamicState& state, const IntegratorCheckpoint& c);
+  // The step's system matrix (its pattern is fixed for the run; the solver's checkpoint refers to it).
+  const Eigen::SparseMatrix<double>& system_matrix() const { return system_; }
   // Displacement from the rest state (3·#nodes) [m] of the last state reached, consistent.
   const Eigen::VectorXd& displacement() const { return u_; }
 

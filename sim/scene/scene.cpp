@@ -709,11 +709,14 @@ InitialState read_initial(const Reader& r, const Json* j) {
   return s;
 }
 
-// "output": {"obj": bool, "obj_level": int}: whether OBJ frames are wanted, and the refinement
-// level of the surface they hold.
+// "output": {"obj": bool, "obj_level": int, "checkpoint_every": int}: whether OBJ frames are
+// wanted, the refinement level of the surface they hold, and how often (in frames) a checkpoint
+// is written for --resume.
 void read_output(const Reader& r, const Json* j, Scene& scene) {
   if (j == nullptr) return;
-  r.check_object(*j, "output", {"obj", "obj_level"});
+  r.check_object(*j, "output", {"obj", "obj_level", "checkpoint_every"});
+  if (const Json* every = r.find(*j, "checkpoint_every"))
+    scene.checkpoint_every = r.integer_at_least(*every, "output.checkpoint_every", 0);
   if (const Json* obj = r.find(*j, "obj")) scene.write_obj_frames = r.boolean(*obj, "output.obj");
   if (const Json* level = r.find(*j, "obj_level")) {
     scene.obj_level = r.integer_at_least(*level, "output.obj_level", 0);

@@ -69,8 +69,11 @@ struct Scene {
   bool write_obj_frames = false;  // dynamic scenes: "output": {"obj": true}
   int obj_level = 0;              // "output.obj_level": OBJ frames hold the limit surface refined this
                                   // many times (0: the limit points at the control connectivity)
+  int checkpoint_every = 0;       // "output.checkpoint_every": a checkpoint for --resume every this
+                                  // many frames (0: only when interrupted)
   RenderSettings render;
   std::vector<Probe> probes;
+  std::vector<std::string> overrides;  // the --set arguments applied, in order (see load_scene)
 };
 
 // Reads, validates and builds the scene in `file`; relative mesh paths are resolved against the

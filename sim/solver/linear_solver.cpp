@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <chrono>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 namespace clothsim {
 
@@ -23,6 +25,7 @@ struct LinearSolver::Impl {
   int solves_since_factor = 0;
   double iterations_since_factor = 0.0;
   bool refactor_next = false;
+  Eigen::VectorXd factored_values;  // of the matrix last factorised for the preconditioner (checkpoints)
   explicit Impl(bool supernodal) : direct(supernodal) {}
 };
 
@@ -39,6 +42,7 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
   auto refactor = [&] {
     const auto f0 = std::chrono::steady_clock::now();
     m.factor.factorize(a, &free);  // of the Dirichlet form
+    m.factored_values = Eigen::Map<const Eigen::VectorXd>(a.valuePtr(), a.nonZeros());
     ++report.factorizations;
     report.factor_ms += ms_since(f0);
     m.solves_since_factor = 0;
@@ -123,6 +127,35 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
     report.failure = text.str();
   }
   return report;
+}
+
+LinearSolverCheckpoint LinearSolver::checkpoint() const {
+  const Impl& m = *impl_;
+  LinearSolverCheckpoint c;
+  if (m.factor.ready()) c.factored_values = m.factored_values;
+  c.solves_since_factor = m.solves_since_factor;
+  c.iterations_since_factor = m.iterations_since_factor;
+  c.refactor_next = m.refactor_next;
+  return c;
+}
+
+void LinearSolver::restore(const LinearSolverCheckpoint& c, const Eigen::SparseMatrix<double>& pattern,
+                           const std::vector<char>& free) {
+  Impl& m = *impl_;
+  if (c.factored_values.size() > 0) {
+    if (c.factored_values.size() != pattern.nonZeros())
+      throw std::invalid_argument("LinearSolver::restore: " + std::to_string(c.factored_values.size()) +
+                                  " matrix values for a pattern of " + std::to_string(pattern.nonZeros()));
+    if (settings_.type != LinearSolverType::pcg || settings_.preconditioner != PreconditionerType::cholesky)
+      throw std::invalid_argument("LinearSolver::restore: a factor for a solver without the Cholesky preconditioner");
+    Eigen::SparseMatrix<double> a = pattern;
+    Eigen::Map<Eigen::VectorXd>(a.valuePtr(), a.nonZeros()) = c.factored_values;
+    m.factor.factorize(a, &free);
+    m.factored_values = c.factored_values;
+  }
+  m.solves_since_factor = c.solves_since_factor;
+  m.iterations_since_factor = c.iterations_since_factor;
+  m.refactor_next = c.refactor_next;
 }
 
 Preconditioner LinearSolver::preconditioner(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) const {

@@ -39,6 +39,16 @@ struct LinearSolveReport {
   std::string failure;      // why it did not converge (a sentence with advice), when !converged
 };
 
+// What a run must save to continue later with bit-identical solves: the Cholesky preconditioner's
+// factor is of an earlier step's matrix, so the values of that matrix (on the integrator's fixed
+// pattern) and the refresh counters are kept, and the factor is computed again from them.
+struct LinearSolverCheckpoint {
+  Eigen::VectorXd factored_values;  // the matrix's values when it was last factorised (empty: no factor)
+  int solves_since_factor = 0;
+  double iterations_since_factor = 0.0;
+  bool refactor_next = false;
+};
+
 class LinearSolver {
  public:
   // `size`: rows of the systems to come.
@@ -61,6 +71,13 @@ class LinearSolver {
   Preconditioner preconditioner(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) const;
 
   const LinearSolverSettings& settings() const { return settings_; }
+
+  // The state that later solves depend on (see LinearSolverCheckpoint).
+  LinearSolverCheckpoint checkpoint() const;
+  // Puts the solver into the state `c` was taken in: refactorises the matrix with `pattern`'s
+  // pattern and c's values, on the entries with free[i] != 0 (as solve() did). Throws
+  // std::invalid_argument if the values do not fit the pattern.
+  void restore(const LinearSolverCheckpoint& c, const Eigen::SparseMatrix<double>& pattern, const std::vector<char>& free);
 
  private:
   struct Impl;
