@@ -122,7 +122,11 @@ void apply_end_option(Scene& scene, const RunOptions& options) {
   if (options.frames) {
     if (scene.analysis != "dynamic") throw std::runtime_error("--frames: only applies to dynamic scenes");
     if (*options.frames < 1) throw std::runtime_error("--frames: must be >= 1");
-    const double end = std::max(scene.problem.time.dt, (*options.frames - 1) / scene.problem.time.output_fps);
+    // The last frame's time, rounded up to a whole number of steps (so that the run does not
+    // warn that its end is not a multiple of time.dt: that end is this option's choice).
+    const double dt = scene.problem.time.dt;
+    const double last_frame = (*options.frames - 1) / scene.problem.time.output_fps;
+    const double end = std::max(dt, std::ceil(last_frame / dt - 1e-9) * dt);
     scene.problem.time.end = end;
     if (const std::string problem = time_limit_problem(scene.problem.time); !problem.empty())
       throw std::runtime_error("--frames: " + problem);

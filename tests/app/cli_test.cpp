@@ -411,6 +411,8 @@ TEST_F(CliTest, FramesOptionSizeAndNoRender) {
   // --frames 3 at 500 fps: t = 0, 2, 4 ms, one PNG each at the requested size.
   RunResult r = run(shell_quote(scene.string()) + " --out " + shell_quote(out_.string()) + " --frames 3 --size 64x48");
   ASSERT_EQ(r.exit_code, 0) << r.err;
+  // The end --frames chooses is a whole number of steps: no warning about the run's own option.
+  EXPECT_FALSE(contains(r.err, "not a multiple of time.dt")) << r.err;
   int pngs = 0;
   for (const auto& e : fs::directory_iterator(out_ / "cloth")) pngs += e.path().extension() == ".png";
   EXPECT_EQ(pngs, 3);
@@ -436,10 +438,10 @@ TEST_F(CliTest, RenderCommandRedrawsSavedFrames) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   int objs = 0, pngs = 0;
   for (const auto& e : fs::directory_iterator(run_dir / "frames")) objs += e.path().extension() == ".obj";
-  for (const auto& e : fs::directory_iterator(run_dir)) pngs += e.path().extension() == ".png";
+  for (const auto& e : fs::directory_iterator(run_dir / "render")) pngs += e.path().extension() == ".png";
   EXPECT_EQ(objs, 6);
   EXPECT_EQ(pngs, objs);
-  const clothsim::render::Image image = clothsim::render::read_png((run_dir / "frame_0005.png").string());
+  const clothsim::render::Image image = clothsim::render::read_png((run_dir / "render" / "frame_0005.png").string());
   EXPECT_EQ(image.width, 80);
   // Not plain background: the (red) cloth is in the picture.
   int coloured = 0;
@@ -466,6 +468,21 @@ TEST_F(CliTest, RenderCommandRefusesRefinedFrames) {
   int pngs = 0;
   for (const auto& e : fs::directory_iterator(out_ / "cloth")) pngs += e.path().extension() == ".png";
   EXPECT_EQ(pngs, 0);
+}
+
+TEST_F(CliTest, VideoWithoutFfmpegFailsBeforeSimulating) {
+  const fs::path scene = write("cloth.json", kFallingCloth);
+  // A PATH without ffmpeg (the binary is named by its absolute path).
+  const fs::path bin = dir_ / "bin";
+  fs::create_directories(bin);
+  const std::string command = "PATH=" + shell_quote(bin.string()) + " " + shell_quote(CLOTHSIM_BINARY) + " " +
+                              shell_quote(scene.string()) + " --out " + shell_quote((dir_ / "v").string()) +
+                              " --frames 4 --video 2>" + shell_quote((dir_ / "err.txt").string());
+  EXPECT_EQ(clothsim::testing::run_shell(command), 1);
+  const std::string err = read_text(dir_ / "err.txt");
+  EXPECT_TRUE(contains(err, "--video: ffmpeg is not installed")) << err;
+  EXPECT_FALSE(contains(err, "dynamic analysis:")) << "it simulated first: " << err;
+  EXPECT_FALSE(fs::exists(dir_ / "v")) << "an output folder was created";
 }
 
 TEST_F(CliTest, VideoOptionEncodesTheFramesWithFfmpeg) {
