@@ -43,13 +43,14 @@ CompareResult compare_images(const Image& a, const Image& b, int tolerance, Imag
   const std::size_t pixels = a.rgb.size() / 3;
   int max_abs = 0;
   std::size_t over = 0;
-  double squared_sum = 0;
+  double abs_sum = 0, squared_sum = 0;
   for (std::size_t p = 0; p < pixels; ++p) {
     bool pixel_over = false;
     for (std::size_t c = 3 * p; c < 3 * p + 3; ++c) {
       const int d = std::abs(int{a.rgb[c]} - int{b.rgb[c]});
       max_abs = std::max(max_abs, d);
       pixel_over = pixel_over || d > tolerance;
+      abs_sum += d;
       squared_sum += static_cast<double>(d) * d;
       if (diff != nullptr) diff->rgb[c] = static_cast<std::uint8_t>(std::min(255, kDiffGain * d));
     }
@@ -58,6 +59,7 @@ CompareResult compare_images(const Image& a, const Image& b, int tolerance, Imag
   CompareResult result;
   result.max_abs = max_abs;
   result.fraction_over = pixels > 0 ? static_cast<double>(over) / static_cast<double>(pixels) : 0;
+  result.mean_abs = a.rgb.empty() ? 0 : abs_sum / static_cast<double>(a.rgb.size());
   const double mse = a.rgb.empty() ? 0 : squared_sum / static_cast<double>(a.rgb.size());
   result.psnr_db =
       mse > 0 ? 10.0 * std::log10(255.0 * 255.0 / mse) : std::numeric_limits<double>::infinity();

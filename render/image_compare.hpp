@@ -8,6 +8,7 @@ namespace clothsim::render {
 
 struct CompareResult {
   double max_abs = 0;        // largest per-channel absolute difference, 0..255
+  double mean_abs = 0;       // mean per-channel absolute difference, 0..255
   double fraction_over = 0;  // fraction of pixels with some channel differing by > tolerance
   double psnr_db = 0;        // 10 log10(255² / mean squared channel error); +inf if identical
 };

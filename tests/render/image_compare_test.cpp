@@ -1,5 +1,5 @@
-// Image comparison: identical images, a few changed pixels, the difference image, tolerance
-// boundary and size mismatch.
+// Image comparison: identical images, a few changed pixels (largest, mean and fraction over the
+// tolerance), the difference image, tolerance boundary and size mismatch.
 #include "render/image_compare.hpp"
 
 #include <gtest/gtest.h>
@@ -25,6 +25,7 @@ TEST(ImageCompareTest, IdenticalImagesHaveInfinitePsnr) {
   Image diff;
   const CompareResult r = compare_images(a, a, 0, &diff);
   EXPECT_EQ(r.max_abs, 0);
+  EXPECT_EQ(r.mean_abs, 0);
   EXPECT_EQ(r.fraction_over, 0);
   EXPECT_TRUE(std::isinf(r.psnr_db));
   EXPECT_GT(r.psnr_db, 0);
@@ -43,6 +44,7 @@ TEST(ImageCompareTest, ReportsChangedPixels) {
   const CompareResult r = compare_images(a, b, 5, &diff);
   EXPECT_EQ(r.max_abs, 10);
   EXPECT_DOUBLE_EQ(r.fraction_over, 3.0 / 80.0);
+  EXPECT_DOUBLE_EQ(r.mean_abs, 3 * 10.0 / (80 * 3));
   const double mse = 3 * 100.0 / (80 * 3);
   EXPECT_NEAR(r.psnr_db, 10 * std::log10(255.0 * 255.0 / mse), 1e-9);
   EXPECT_EQ(diff.rgb[pixel_offset(diff, 1, 1)], 40);
