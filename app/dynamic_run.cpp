@@ -12,6 +12,7 @@
 
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/obj_io.hpp"
+#include "sim/scene/render_settings_json.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -164,6 +165,7 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                    {"frames", totals.frames},
                    {"max_solver_iterations", totals.max_solver_iterations},
                    {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)},
+                   {"render", render_settings_json(scene.render)},
                    {"warnings", warnings},
                    {"status", status}};
   if (scene.problem.has_contact())

@@ -1,6 +1,7 @@
 // Command-line entry point: `clothsim SCENE.json [--out DIR] [--end T]`. Argument parsing (CLI11)
 // lives in this file only; the work is done by run_scene_file (app/run.hpp).
 #include "app/figures.hpp"
+#include "app/render_saved.hpp"
 #include "app/run.hpp"
 #include "app/study.hpp"
 
@@ -27,23 +28,53 @@ int parse(CLI::App& app, int argc, char** argv) {
   return -1;
 }
 
-// `clothsim render DIR [--size WxH]`.
-int render_command(int argc, char** argv) {
-  CLI::App app{"clothsim render: draw the saved frames DIR/frames/mesh_*.obj of a dynamic run again into\n"
-               "DIR/frame_NNNN.png, without simulating.",
-               "clothsim render"};
-  std::string dir, size;
-  app.add_option("dir", dir, "Output folder of a run (with frames/mesh_*.obj)")->required()->type_name("DIR");
-  app.add_option("--size", size, "Image size, e.g. 960x720")->type_name("WxH");
-  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
-  int width = 0, height = 0, used = 0;
-  if (!size.empty() && (std::sscanf(size.c_str(), "%dx%d%n", &width, &height, &used) != 2 ||
-                        used != static_cast<int>(size.size()) || width < 16 || height < 16 || width > 8192 ||
-                        height > 8192)) {
-    std::cerr << "clothsim: error: --size: expected WxH with 16 <= W, H <= 8192 (got \"" << size << "\")\n";
-    return 1;
+// Parses "WxH" with 16 <= W, H <= `max`; prints the error naming `option` and returns false
+// for anything else (also trailing characters).
+bool parse_size(const std::string& option, const std::string& size, int max, int& width, int& height) {
+  int used = 0;
+  if (std::sscanf(size.c_str(), "%dx%d%n", &width, &height, &used) != 2 || used != static_cast<int>(size.size()) ||
+      width < 16 || height < 16 || width > max || height > max) {
+    std::cerr << "clothsim: error: " << option << ": expected WxH with 16 <= W, H <= " << max << " (got \"" << size
+              << "\")\n";
+    return false;
   }
-  return clothsim::render_saved_frames(dir, width, height);
+  return true;
+}
+
+// `clothsim render DIR [--out DIR2] [--size WxH] [--refine K] [--surface S]`.
+int render_command(int argc, char** argv) {
+  CLI::App app{"clothsim render: draws a run's saved geometry again, without simulating: a dynamic run's\n"
+               "DIR/frames/mesh_NNNN.obj (\"output\": {\"obj\": true}) into frame_NNNN.png, a static run's\n"
+               "DIR/limit.obj into limit.png. Uses the render settings the run saved (\"render\" in\n"
+               "DIR/summary.json or DIR/result.json; the defaults, with a notice, for older runs), with\n"
+               "the overrides below, and the run's render.camera or else a camera framing the whole\n"
+               "sequence. Writes a NEW folder (default DIR/render/) with the pictures and render.json\n"
+               "(the settings used); the run's own files are not changed. An existing output folder\n"
+               "is replaced only if an earlier `clothsim render` wrote it.",
+               "clothsim render"};
+  std::string dir, out, size, surface;
+  int refine = 0;
+  app.add_option("dir", dir, "Output folder of a run (with frames/mesh_*.obj or limit.obj)")->required()->type_name("DIR");
+  app.add_option("--out", out, "Output folder (default DIR/render)")->type_name("DIR2");
+  app.add_option("--size", size, "Image size, e.g. 960x720 (default: the run's)")->type_name("WxH");
+  CLI::Option* refine_option =
+      app.add_option("--refine", refine, "Refinement steps of the drawn surface, 0-4 (default: the run's)")
+          ->check(CLI::Range(0, 4))
+          ->type_name("K");
+  app.add_option("--surface", surface,
+                 "Surface drawn: method (what the run's method drew), loop_limit or flat (default: the run's)")
+      ->check(CLI::IsMember({"method", "loop_limit", "flat"}))
+      ->type_name("S");
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
+  clothsim::RenderSavedOptions options;
+  options.out = out;
+  if (!size.empty() && !parse_size("--size", size, 8192, options.width, options.height)) return 1;
+  if (refine_option->count() > 0) options.refine = refine;
+  if (!surface.empty())
+    options.surface = surface == "loop_limit" ? clothsim::DrawnSurface::loop_limit
+                      : surface == "flat"     ? clothsim::DrawnSurface::flat
+                                              : clothsim::DrawnSurface::method;
+  return clothsim::render_saved_run(dir, options);
 }
 
 // `clothsim study convergence|stability|folds [--out DIR] [--quick] [--no-plot]`, and for `folds`

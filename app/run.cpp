@@ -11,6 +11,7 @@
 #include "render/renderer.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/core/layout.hpp"
+#include "sim/scene/render_settings_json.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/setup/setup.hpp"
 #include "sim/static/static_solve.hpp"
@@ -57,7 +58,8 @@ std::string result_json(const Scene& scene, const StaticResult& result) {
                      {"vertices", scene.problem.mesh.num_vertices()},
                      {"dofs", result.dofs},
                      {"seconds", {{"assemble", result.assemble_seconds}, {"solve", result.solve_seconds}}},
-                     {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)}};
+                     {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)},
+                     {"render", render_settings_json(scene.render)}};
   return out.dump(2) + "\n";
 }
 
@@ -269,72 +271,6 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
       throw std::runtime_error("cannot write the results to " + (out_root / scene.name).string() + ": " + e.what());
     }
     print_summary(scene, result, out_root / scene.name);
-    return 0;
-  } catch (const std::exception& e) {
-    std::cerr << "clothsim: error: " << e.what() << '\n';
-    return 1;
-  }
-}
-
-int render_saved_frames(const fs::path& dir, int width, int height) {
-  try {
-    std::vector<fs::path> files;
-    const fs::path frames = dir / "frames";
-    if (!fs::is_directory(frames))
-      throw std::runtime_error(frames.string() + ": no such folder (run the scene with \"output\": {\"obj\": true})");
-    for (const auto& entry : fs::directory_iterator(frames)) {
-      const std::string name = entry.path().filename().string();
-      if (name.rfind("mesh_", 0) == 0 && entry.path().extension() == ".obj") files.push_back(entry.path());
-    }
-    std::sort(files.begin(), files.end());
-    if (files.empty()) throw std::runtime_error(frames.string() + ": no mesh_*.obj frames");
-    {  // Frames of the refined surface (output.obj_level > 0) are not control meshes.
-      std::ifstream first(files.front());
-      std::string comment;
-      std::getline(first, comment);
-      if (comment.find("(refined ") != std::string::npos)
-        throw std::runtime_error(files.front().string() +
-                                 ": holds the refined surface (\"output.obj_level\" > 0); clothsim render draws frames "
-                                 "written with obj_level 0 (the limit points at the control connectivity)");
-    }
-    // The saved meshes are limit points at the control connectivity; they are drawn as control
-    // meshes of their own subdivision surface (a slightly smoothed picture of the same surface).
-    RenderSettings settings;
-    if (width > 0) settings.width = width;
-    if (height > 0) settings.height = height;
-    // Two passes over the files, so that only one frame is in memory at a time: the bounds of the
-    // whole sequence for the camera, then the pictures.
-    std::shared_ptr<Discretization> surface;  // the saved mesh as a Loop control mesh
-    std::unique_ptr<LimitSurfaceDrawer> drawer;
-    render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
-    std::vector<Triangle> first_triangles;
-    for (const fs::path& file : files) {
-      const TriMesh mesh = read_obj(file.string());
-      if (!drawer) {
-        first_triangles = mesh.triangles;
-        Problem control;  // no boundary, default material: only the surface operators are used
-        control.method = "loop_kl";
-        control.mesh = mesh;
-        surface = make_discretization(control);
-        drawer = std::make_unique<LimitSurfaceDrawer>(*surface, settings, settings.width, settings.height);
-      } else if (mesh.triangles != first_triangles) {
-        throw std::runtime_error(file.string() + ": its triangles differ from " + files.front().string());
-      }
-      LimitSurfaceDrawer::extend_bounds(drawer->snapshot(to_flat(mesh.vertices)), lo, hi);
-    }
-    render::Renderer renderer(settings.width, settings.height);
-    const render::Camera camera = drawer->camera(lo, hi);
-    for (std::size_t k = 0; k < files.size(); ++k) {
-      const TriMesh mesh = read_obj(files[k].string());
-      if (mesh.triangles != first_triangles)  // changed since the first pass
-        throw std::runtime_error(files[k].string() + ": its triangles differ from " + files.front().string());
-      char name[32];
-      std::snprintf(name, sizeof(name), "frame_%04zu.png", k);
-      const SurfaceSnapshot snapshot = drawer->snapshot(to_flat(mesh.vertices));
-      render::write_png((dir / name).string(), renderer.render(drawer->frame(snapshot, camera, lo[1])));
-    }
-    std::cout << "rendered " << files.size() << " frame(s) from " << frames.string() << " to "
-              << (dir / "frame_*.png").string() << "\n";
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "clothsim: error: " << e.what() << '\n';
