@@ -1,6 +1,8 @@
 // Command-line entry point: `clothsim SCENE.json [--out DIR] [--end T]`. Argument parsing (CLI11)
 // lives in this file only; the work is done by run_scene_file (app/run.hpp).
+#include "app/compare.hpp"
 #include "app/figures.hpp"
+#include "app/golden.hpp"
 #include "app/render_saved.hpp"
 #include "app/run.hpp"
 #include "app/study.hpp"
@@ -75,6 +77,87 @@ int render_command(int argc, char** argv) {
                       : surface == "flat"     ? clothsim::DrawnSurface::flat
                                               : clothsim::DrawnSurface::method;
   return clothsim::render_saved_run(dir, options);
+}
+
+// The tolerance options of `compare` and `golden check`.
+void add_tolerance_options(CLI::App& app, clothsim::ImageTolerance& tolerance, double& percent) {
+  app.add_option("--tolerance", tolerance.channel,
+                 "A pixel differs if one of its channels differs by more than N (of 255)")
+      ->check(CLI::Range(0, 255))
+      ->type_name("N")
+      ->capture_default_str();
+  percent = 100 * tolerance.max_fraction;
+  app.add_option("--max-differing", percent, "The images are the same if at most P % of their pixels differ")
+      ->check(CLI::Range(0.0, 100.0))
+      ->type_name("P")
+      ->capture_default_str();
+}
+
+// `clothsim compare A B [--tolerance N] [--max-differing P] [--diff PATH]`.
+int compare_command(int argc, char** argv) {
+  CLI::App app{"clothsim compare: compares two PNG images, or the PNG images of two folders (e.g. two runs'\n"
+               "frame_NNNN.png / limit.png, or a run and its `clothsim render` output) pairwise by file\n"
+               "name; an image present in one folder only counts as a difference. Prints per image the\n"
+               "size, the largest and mean channel difference and the share of pixels that differ.\n"
+               "Exit code 0: every image the same within the tolerance; 1: some image differs, has\n"
+               "another size or is missing; 2: usage error or unreadable input.",
+               "clothsim compare"};
+  std::string a, b, diff;
+  clothsim::ImageTolerance tolerance;
+  double percent = 0;
+  app.add_option("a", a, "First PNG file or folder")->required()->type_name("A");
+  app.add_option("b", b, "Second PNG file or folder")->required()->type_name("B");
+  add_tolerance_options(app, tolerance, percent);
+  app.add_option("--diff", diff,
+                 "Write the difference image(s), 4 x |A - B| per channel: a PNG file for two files; for two\n"
+                 "folders a new folder with one image per pair of equal size (named as the pair) and the\n"
+                 "report compare.txt (an existing folder is replaced only if it holds a compare.txt)")
+      ->type_name("PATH");
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code == 0 ? 0 : clothsim::kExitError;
+  tolerance.max_fraction = percent / 100;
+  return clothsim::compare_command(a, b, tolerance, diff);
+}
+
+// `clothsim golden check|update MANIFEST [--tolerance N] [--max-differing P] [--failures DIR]`.
+int golden_command(int argc, char** argv) {
+  CLI::App app{"clothsim golden: golden images of your own scenes. MANIFEST lists one golden per line,\n"
+               "  GOLDEN.png  SCENE.json  RENDERED  OPTIONS...\n"
+               "(GOLDEN and SCENE relative to the manifest's folder, RENDERED relative to the run's output\n"
+               "folder, e.g. plate/limit.png; OPTIONS further clothsim options; '#' starts a comment).\n"
+               "`check` runs `clothsim SCENE --out TMP OPTIONS...` for each line in a temporary folder and\n"
+               "compares RENDERED with GOLDEN (as `clothsim compare`); the rendered and difference\n"
+               "images of failures and the report go to the --failures folder. Exit code 0: all pass;\n"
+               "1: some golden failed; 2: usage or manifest error. `update` runs every line and, if all\n"
+               "runs succeed, rewrites the goldens (each atomically; unchanged files are not touched).\n"
+               "See tests/golden/README.md.",
+               "clothsim golden"};
+  std::string action, manifest, failures;
+  clothsim::ImageTolerance tolerance;
+  double percent = 0;
+  app.add_option("action", action, "check or update")
+      ->required()
+      ->check(CLI::IsMember({"check", "update"}))
+      ->type_name("ACTION");
+  app.add_option("manifest", manifest, "The list of goldens")->required()->type_name("MANIFEST");
+  add_tolerance_options(app, tolerance, percent);
+  app.add_option("--failures", failures,
+                 "check: folder for the failures' images and report, replaced by each check and removed\n"
+                 "when all pass (default $TMPDIR/clothsim_golden_failures)")
+      ->type_name("DIR");
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code == 0 ? 0 : clothsim::kExitError;
+  if (action == "update") {
+    for (const char* name : {"--tolerance", "--max-differing", "--failures"})
+      if (app.get_option(name)->count() > 0) {
+        std::cerr << "clothsim: error: " << name << " applies to `clothsim golden check` only\n";
+        return clothsim::kExitError;
+      }
+    return clothsim::golden_update(manifest);
+  }
+  clothsim::GoldenCheckOptions options;
+  tolerance.max_fraction = percent / 100;
+  options.tolerance = tolerance;
+  options.failures = failures;
+  return clothsim::golden_check(manifest, options);
 }
 
 // `clothsim study convergence|stability|folds [--out DIR] [--quick] [--no-plot]`, and for `folds`
@@ -173,6 +256,8 @@ int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "render") return render_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "study") return study_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "figures") return figures_command(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "compare") return compare_command(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "golden") return golden_command(argc, argv);
   CLI::App app{
       "clothsim: Kirchhoff-Love thin-shell cloth simulator on Loop-subdivision surfaces.\n"
       "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes its\n"
