@@ -89,6 +89,15 @@ const std::map<std::string, Form>& forms() {
          "--frames 1 --size 32x32 --video; fi"},
         "{clothsim} --help",
         ""}},
+      // Interrupted with SIGINT once its second step is out (of 300), then resumed; ResumeTest.*
+      // checks the bytes.
+      {"clothsim SCENE.json --resume DIR",
+       {{"{clothsim} {src}/scenes/sleeve_twist.json --out {tmp}/out_resume --end 0.3 --no-render >/dev/null 2>&1 & p=$!; "
+         "s={tmp}/out_resume/sleeve_twist/stats.csv; "
+         "while [ \"$(cat $s 2>/dev/null | wc -l)\" -lt 3 ]; do sleep 0.02; done; kill -INT $p; wait $p; test $? -eq 130",
+         "{clothsim} {src}/scenes/sleeve_twist.json --end 0.3 --no-render --resume {tmp}/out_resume/sleeve_twist"},
+        "{clothsim} --help",
+        ""}},
       // Install packages, build, run: only their syntax is checked.
       {"scripts/install_deps.sh", {{"test -x {src}/scripts/install_deps.sh", "bash -n {src}/scripts/install_deps.sh"}, "", ""}},
       {"scripts/demo.sh", {{"test -x {src}/scripts/demo.sh", "bash -n {src}/scripts/demo.sh"}, "", ""}},
