@@ -9,7 +9,18 @@ void check_triangles(const TriMesh& mesh) {
   if (n == 0) throw MeshError("mesh has no vertices");
   if (mesh.triangles.empty()) throw MeshError("mesh has no triangles");
   if (!mesh.vertices.allFinite()) throw MeshError("mesh has a non-finite vertex coordinate");
-  const double diag2 = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).squaredNorm();
+  // The test runs on the mesh moved to the origin and scaled to unit size (dividing before
+  // subtracting, so no difference overflows), so that it does not depend on the mesh's units: a
+  // valid mesh scaled by 1e-160 or 1e300 passes as it does at 1 m (its squared edges would
+  // underflow to zero or overflow to infinity).
+  const Eigen::RowVector3d lo = mesh.vertices.colwise().minCoeff(), hi = mesh.vertices.colwise().maxCoeff();
+  double scale = (0.5 * hi - 0.5 * lo).cwiseAbs().maxCoeff();
+  if (!(scale > 0)) scale = 1.0;  // every vertex at one point: every triangle is degenerate
+  const Eigen::RowVector3d center = 0.5 * lo + 0.5 * hi;
+  auto unit = [&](int v) -> Eigen::Vector3d {
+    return (mesh.vertices.row(v) / scale - center / scale).transpose();
+  };
+  const double diag2 = (hi / scale - lo / scale).squaredNorm();
   for (int t = 0; t < mesh.num_triangles(); ++t) {
     const Triangle& tri = mesh.triangles[t];
     const std::string name = "triangle " + std::to_string(t) + " (" + std::to_string(tri[0]) + ", " +
@@ -19,8 +30,8 @@ void check_triangles(const TriMesh& mesh) {
         throw MeshError(name + ": vertex index out of range (mesh has " + std::to_string(n) + " vertices)");
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2])
       throw MeshError(name + " is degenerate: repeated vertex");
-    const Eigen::Vector3d e1 = mesh.vertices.row(tri[1]) - mesh.vertices.row(tri[0]);
-    const Eigen::Vector3d e2 = mesh.vertices.row(tri[2]) - mesh.vertices.row(tri[0]);
+    const Eigen::Vector3d p0 = unit(tri[0]);
+    const Eigen::Vector3d e1 = unit(tri[1]) - p0, e2 = unit(tri[2]) - p0;
     if (e1.cross(e2).norm() <= 1e-12 * diag2) throw MeshError(name + " is degenerate: zero area");
   }
 }

@@ -30,8 +30,21 @@ class MeshError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// Thrown when a mesh is larger than the limit it is read with (read_obj's max_vertices).
+class MeshLimitError : public MeshError {
+ public:
+  using MeshError::MeshError;
+};
+
+// The default limit on a mesh's vertex count (the scene key mesh.max_vertices; read_obj's
+// max_vertices): a million, ten times the 100k-vertex meshes the solvers are tuned for, checked
+// before anything of that size is allocated.
+inline constexpr long long kDefaultMaxVertices = 1'000'000;
+
 // Throws MeshError for a triangle with a repeated or out-of-range index or (near) zero area
-// (area below 1e-12 of the squared bounding-box diagonal), naming the triangle.
+// (twice its area below 1e-12 of the squared bounding-box diagonal), naming the triangle. The
+// test is relative: it runs on the mesh scaled to unit size, so a valid mesh passes at any scale
+// (1e-150 m or 1e150 m as at 1 m).
 void check_triangles(const TriMesh& mesh);
 
 // Lumped mass per vertex [kg]: a third of each incident triangle's rest area [m²] times

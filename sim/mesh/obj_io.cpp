@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
@@ -68,18 +69,60 @@ struct PendingTriangle {
   throw MeshError(path + ":" + std::to_string(line) + ": " + message);
 }
 
+// Reads the next line (without its '\n') into `line`; false at the end of the input. Sets
+// `too_long` and stops reading once the line has more than `max_length` characters, so that a
+// file without line breaks is not read into memory whole.
+bool next_line(std::streambuf& buffer, std::string& line, std::size_t max_length, bool& too_long) {
+  using Traits = std::char_traits<char>;
+  line.clear();
+  too_long = false;
+  Traits::int_type c = buffer.sbumpc();
+  if (Traits::eq_int_type(c, Traits::eof())) return false;
+  while (!Traits::eq_int_type(c, Traits::eof()) && c != '\n') {
+    if (line.size() >= max_length) {
+      too_long = true;
+      return true;
+    }
+    line.push_back(Traits::to_char_type(c));
+    c = buffer.sbumpc();
+  }
+  return true;
+}
+
 }  // namespace
 
-TriMesh read_obj(const std::string& path) {
-  std::ifstream in(path);
+TriMesh read_obj(const std::string& path, long long max_vertices) {
+  // Only a regular file (or a link to one): a device such as /dev/zero or a pipe has no end.
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw MeshError(path + ": not a regular file (" +
+                    std::string(std::filesystem::is_directory(status) ? "a directory" : "a device, pipe or socket") +
+                    "); a mesh must be an OBJ file");
+  std::ifstream in(path, std::ios::binary);
   if (!in) throw MeshError(path + ": cannot open file");
+  return read_obj(in, path, max_vertices);
+}
 
+TriMesh read_obj_text(std::string_view text, const std::string& name, long long max_vertices) {
+  std::istringstream in{std::string(text)};
+  return read_obj(in, name, max_vertices);
+}
+
+TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertices) {
+  if (in.rdbuf() == nullptr || !in) throw MeshError(path + ": cannot read");
+  // A manifold triangle mesh has about twice as many triangles as vertices (a closed surface of
+  // genus g: 2V + 4g - 4); four times is room for any practical mesh.
+  const long long max_triangles = 4 * max_vertices;
   std::vector<std::array<double, 3>> positions;
   std::vector<PendingTriangle> pending;
   std::string text;
   long long line_number = 0;
-  while (std::getline(in, text)) {
+  bool too_long = false;
+  while (next_line(*in.rdbuf(), text, kMaxObjLineLength, too_long)) {
     ++line_number;
+    if (too_long)
+      fail(path, line_number, "line longer than " + std::to_string(kMaxObjLineLength) + " characters (not an OBJ file?)");
     std::string_view line(text);
     if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
@@ -100,6 +143,9 @@ TriMesh read_obj(const std::string& path) {
           p[k - 1] = value;
         }
       }
+      if (static_cast<long long>(positions.size()) >= max_vertices)
+        throw MeshLimitError(path + ":" + std::to_string(line_number) + ": more than " + std::to_string(max_vertices) +
+                             " vertices");
       positions.push_back(p);
     } else if (tokens[0] == "f") {
       if (tokens.size() < 4)
@@ -139,6 +185,9 @@ TriMesh read_obj(const std::string& path) {
         }
       }
       // Fan triangulation around the first corner.
+      if (static_cast<long long>(pending.size() + corners.size() - 2) > max_triangles)
+        throw MeshLimitError(path + ":" + std::to_string(line_number) + ": more than " + std::to_string(max_triangles) +
+                             " triangles (4 x the limit of " + std::to_string(max_vertices) + " vertices)");
       for (std::size_t k = 1; k + 1 < corners.size(); ++k)
         pending.push_back({{corners[0], corners[k], corners[k + 1]}, line_number});
     }

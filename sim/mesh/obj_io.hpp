@@ -6,7 +6,10 @@
 
 #include <Eigen/Core>
 
+#include <cstddef>
+#include <iosfwd>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace clothsim {
@@ -21,7 +24,22 @@ namespace clothsim {
 // check_triangles and Topology (degenerate triangles, non-manifold edges or vertices,
 // inconsistent orientation, isolated vertices); those errors are rethrown prefixed with
 // "<path>: ".
-TriMesh read_obj(const std::string& path);
+//
+// Limits, so that no input makes it allocate without bound: `path` must be a regular file (or a
+// link to one; a device such as /dev/zero, a pipe or a directory is refused before it is
+// opened); a line may have at most kMaxObjLineLength characters; reading stops with a
+// MeshLimitError ("<path>:<line>: more than N vertices") at the first vertex beyond
+// `max_vertices`, or the first triangle beyond 4 × `max_vertices` (polygons counted by their fan
+// triangles).
+TriMesh read_obj(const std::string& path, long long max_vertices = kDefaultMaxVertices);
+// The same for OBJ text read from `in` (a file's contents, a string); `name` stands for the file
+// in error messages ("<name>:12: ..."). read_obj(path) opens the file and calls this.
+TriMesh read_obj(std::istream& in, const std::string& name, long long max_vertices = kDefaultMaxVertices);
+// The same for OBJ text in memory (the fuzz target in fuzz/ and tests).
+TriMesh read_obj_text(std::string_view text, const std::string& name, long long max_vertices = kDefaultMaxVertices);
+
+// The longest line read_obj accepts [characters] (a polygon of some 100 000 corners).
+inline constexpr std::size_t kMaxObjLineLength = std::size_t{1} << 20;
 
 // Writes `vertices` [m] and `triangles` (0-based, written 1-based) to an OBJ file, with every
 // coordinate printed in the shortest form that reads back to the identical double. A non-empty
