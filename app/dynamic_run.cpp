@@ -199,12 +199,16 @@ class Outputs {
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
   }
 
-  // Probe rows and due frames for the state reached after `step` steps, at time `t` [s].
+  // Probe rows and due frames for the state reached after `step` steps, at time `t` [s]; writes
+  // out the stats row record_stats() gave for that step too.
   void record_state(const Simulator& sim, int step, double t, RunTotals& totals) {
     const TimeSettings& time = scene_.problem.time;
     const bool frames_wanted = scene_.write_obj_frames || images_ != nullptr;
     const bool frame_due = frames_wanted && t >= totals.frames / time.output_fps - 1e-9 * time.dt;
-    if (scene_.probes.empty() && !frame_due) return;
+    if (scene_.probes.empty() && !frame_due) {
+      stats_.flush();
+      return;
+    }
     if (!scene_.probes.empty()) {
       if (probe_points_.num_points() == 0) {  // the probes' surface points, once
         std::vector<int> nodes;
@@ -220,8 +224,12 @@ class Outputs {
         for (int k = 0; k < 3; ++k) row.append(1, ',').append(format_double(u(static_cast<Eigen::Index>(i), k)));
         probes_.line(row);
       }
-      probes_.flush();
     }
+    // The step's stats row (record_stats) and probe rows go out together, once both are ready,
+    // so that a process killed outright (SIGKILL) is very unlikely to leave one file a step
+    // ahead of the other (--resume cuts both back to its checkpoint anyway).
+    stats_.flush();
+    probes_.flush();
     // Frame k belongs to the first state with t >= k / fps; a step longer than a frame period
     // repeats the frame so that frame k always shows time ≈ k / fps.
     bool repeated = false;
@@ -269,8 +277,7 @@ class Outputs {
                                        format_double(s.contact_ms), std::to_string(s.contact_response_iterations),
                                        std::to_string(s.contact_cg_iterations)})
         row.append(1, ',').append(field);
-    stats_.line(row);
-    stats_.flush();
+    stats_.line(row);  // flushed by record_state, together with the probes
   }
 
   std::uintmax_t probes_bytes() { return probes_.bytes(); }
