@@ -324,6 +324,7 @@ int main(int argc, char** argv) {
   options.video = video;
   if (frames_option->count() > 0) options.frames = frames;
   if (!framing.empty()) options.framing = framing;
+  options.overrides = overrides;
   if (!size.empty()) {
     const auto x = size.find('x');
     try {

@@ -193,7 +193,7 @@ std::uint64_t run_fingerprint(const fs::path& scene_file, const Scene& scene, co
 int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const RunOptions& options) {
   try {
     if (out_root.empty()) throw std::runtime_error("--out: the output folder must not be empty");
-    Scene scene = load_scene(scene_file, log_line);
+    Scene scene = load_scene(scene_file, log_line, options.overrides);
     log_line("scene " + scene.name + ": " + std::to_string(scene.problem.mesh.num_vertices()) +
              " control vertices, " + std::to_string(scene.problem.mesh.num_triangles()) + " triangles");
     apply_end_option(scene, options);

@@ -4,6 +4,7 @@
 #include "sim/scene/scene.hpp"
 #include "sim/scene/render_settings_json.hpp"
 
+#include "sim/mesh/cracks.hpp"
 #include "sim/mesh/imperfection.hpp"
 
 #include "sim/mesh/generators.hpp"
@@ -15,6 +16,7 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
@@ -165,15 +167,44 @@ std::string printable(const std::string& text) {
   return out;
 }
 
+// Whether key path `a` is `b` or contains it or lies inside it ("time" and "time.end";
+// "boundary[0]" and "boundary[0].fix[1]"; not "time" and "timestep").
+bool paths_related(const std::string& a, const std::string& b) {
+  const std::string& shorter = a.size() <= b.size() ? a : b;
+  const std::string& longer = a.size() <= b.size() ? b : a;
+  if (shorter.empty() || longer.compare(0, shorter.size(), shorter) != 0) return false;
+  return longer.size() == shorter.size() || longer[shorter.size()] == '.' || longer[shorter.size()] == '[';
+}
+
+// " (set by --set a=1, --set b=2)" for the overrides whose key paths are related to `path`, or "".
+std::string override_note(const std::string& path, const std::vector<std::pair<std::string, std::string>>& overrides) {
+  std::string note;
+  for (const auto& [key, argument] : overrides)
+    if (paths_related(path, key)) note += (note.empty() ? " (set by --set " : ", --set ") + argument;
+  return note.empty() ? note : note + ")";
+}
+
+// "; did you mean \"x\"?" when `given` is close to one of `allowed`, otherwise "".
+std::string did_you_mean(const std::string& given, const std::vector<std::string>& allowed) {
+  const std::string best = closest_name(given, allowed);
+  return best.empty() ? best : "; did you mean " + quote(best) + "?";
+}
+
 // Typed, checked access to the JSON tree; every failure throws SceneError naming file and key.
 class Reader {
  public:
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
-  // Control characters (a NUL in a key would cut the message short) are written as \uXXXX.
+  // Control characters (a NUL in a key would cut the message short) are written as \uXXXX. A
+  // problem at a key that a --set override wrote (or inside it, or around it) names the override.
   [[noreturn]] void fail(const std::string& path, const std::string& problem) const {
-    throw SceneError(printable(file_ + ": " + (path.empty() ? std::string() : path + ": ") + problem));
+    throw SceneError(printable(file_ + ": " + (path.empty() ? std::string() : path + ": ") + problem +
+                               override_note(path, overrides_)));
   }
+
+  // The key paths (as in messages: "boundary[0].rotation") that --set overrides wrote, each with
+  // its argument as given.
+  void set_overrides(std::vector<std::pair<std::string, std::string>> overrides) { overrides_ = std::move(overrides); }
 
   // `j` must be an object whose keys are all in `allowed`.
   void check_object(const Json& j, const std::string& path,
@@ -183,7 +214,8 @@ class Reader {
       bool known = false;
       for (const std::string& a : allowed) known = known || a == it.key();
       if (!known)
-        fail(join_key(path, it.key()), "unknown key (allowed: " + format_list(allowed, false) + ")");
+        fail(join_key(path, it.key()),
+             "unknown key (allowed: " + format_list(allowed, false) + ")" + did_you_mean(it.key(), allowed));
     }
   }
 
@@ -238,7 +270,8 @@ class Reader {
     const std::string s = j.get<std::string>();
     for (const std::string& a : allowed)
       if (a == s) return s;
-    fail(path, "unknown " + what + " " + quote(s) + " (allowed: " + format_list(allowed, true) + ")");
+    fail(path, "unknown " + what + " " + quote(s) + " (allowed: " + format_list(allowed, true) + ")" +
+                   did_you_mean(s, allowed));
   }
 
   Eigen::Vector3d vec3(const Json& j, const std::string& path) const {
@@ -285,6 +318,7 @@ class Reader {
 
  private:
   std::string file_;
+  std::vector<std::pair<std::string, std::string>> overrides_;
 };
 
 Json parse_text(const Reader& r, const std::string& text);
@@ -332,7 +366,158 @@ Json parse_text(const Reader& r, const std::string& text) {
   return j;
 }
 
-TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log) {
+// `text`, shortened to its first 80 characters for an error message.
+std::string shortened(const std::string& text) {
+  return text.size() > 80 ? text.substr(0, 77) + "..." : text;
+}
+
+// One step of an override's key path: an object key, or an array index written "[n]" (an object
+// key of digits may also index an array: "boundary.0.fix").
+struct KeyStep {
+  std::string key;
+  bool bracket = false;
+};
+
+[[noreturn]] void override_fail(const std::string& shown, const std::string& problem) {
+  throw SceneError(printable(shown + ": " + problem));
+}
+
+// Applies one --set argument "key.path=value" to `root`; returns the key path in the messages'
+// form ("boundary[0].rotation"). The value is JSON if it parses as JSON, otherwise the text as a
+// string; null removes the key (or the array element). Missing objects on the way are created;
+// an index equal to an array's length appends. Throws SceneError("--set <argument>: ...").
+std::string apply_override(Json& root, const std::string& argument, const LogFn& log) {
+  const std::string shown = "--set " + shortened(argument);
+  const std::size_t equals = argument.find('=');
+  if (equals == std::string::npos || equals == 0)
+    override_fail(shown, "expected KEY=VALUE, e.g. --set time.end=0.5 or --set boundary[0].rotation=clamped");
+  const std::string key = argument.substr(0, equals), text = argument.substr(equals + 1);
+
+  // The key path: names separated by '.', each optionally followed by [n] indices.
+  std::vector<KeyStep> steps;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t end = key.find_first_of(".[", pos);
+    const std::string name = key.substr(pos, end == std::string::npos ? std::string::npos : end - pos);
+    if (name.empty())
+      override_fail(shown, "empty key name in " + quote(shortened(key)) + " (write a.b.c, a[0].b or a.0.b)");
+    steps.push_back({name, false});
+    pos = end;
+    while (pos != std::string::npos && key[pos] == '[') {
+      const std::size_t close = key.find(']', pos);
+      const std::string index = close == std::string::npos ? "" : key.substr(pos + 1, close - pos - 1);
+      if (index.empty() || index.size() > 9 || index.find_first_not_of("0123456789") != std::string::npos)
+        override_fail(shown, "malformed index in " + quote(shortened(key)) + " (write [0], [1], ...)");
+      steps.push_back({index, true});
+      pos = close + 1 < key.size() ? close + 1 : std::string::npos;
+    }
+    if (pos == std::string::npos) break;
+    if (key[pos] != '.') override_fail(shown, "expected '.' or '[' after ']' in " + quote(shortened(key)));
+    ++pos;
+  }
+
+  // The value: JSON, or else the text as a string (a value that starts like JSON must be JSON).
+  Json value;
+  bool is_json = false;
+  {
+    DuplicateKeyFinder duplicates;
+    try {
+      value = Json::parse(text, [&duplicates](int, nlohmann::json::parse_event_t event, Json& parsed) {
+        return duplicates.on_event(event, parsed);
+      });
+      is_json = true;
+    } catch (const nlohmann::json::exception& e) {
+      const std::size_t first = text.find_first_not_of(" \t\r\n");
+      if (first != std::string::npos && (text[first] == '[' || text[first] == '{' || text[first] == '"')) {
+        std::string message = e.what();
+        const auto close = message.find("] ");
+        if (!message.empty() && message.front() == '[' && close != std::string::npos) message = message.substr(close + 2);
+        override_fail(shown, "the value is not valid JSON: " + shortened(message));
+      }
+    }
+    if (!duplicates.first_duplicate().empty())
+      override_fail(shown, "the value repeats the key " + quote(duplicates.first_duplicate()));
+  }
+  if (!is_json) value = text;
+  const bool remove = value.is_null();
+
+  Json* node = &root;
+  std::string path;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const KeyStep& step = steps[i];
+    const bool last = i + 1 == steps.size();
+    const bool digits = step.key.find_first_not_of("0123456789") == std::string::npos && step.key.size() <= 9;
+    if (node->is_object() && !step.bracket) {
+      const std::string here = join_key(path, step.key);
+      if (last) {
+        if (remove)
+          node->erase(step.key);
+        else
+          (*node)[step.key] = value;
+        path = here;
+        break;
+      }
+      if (!node->contains(step.key)) {
+        if (remove) return here;  // nothing to remove
+        (*node)[step.key] = Json::object();
+      }
+      node = &(*node)[step.key];
+      path = here;
+    } else if (node->is_array() && digits) {
+      const auto index = static_cast<std::size_t>(std::stoul(step.key));
+      const std::string here = join_index(path, index);
+      if (index > node->size() || (index == node->size() && remove))
+        override_fail(shown, (path.empty() ? std::string("the scene") : path) + " has " + std::to_string(node->size()) +
+                                 (node->size() == 1 ? " element" : " elements") + "; index " + std::to_string(index) +
+                                 " is out of range (" + std::to_string(node->size()) + " appends one)");
+      if (last) {
+        if (remove)
+          node->erase(index);
+        else if (index == node->size())
+          node->push_back(value);
+        else
+          (*node)[index] = value;
+        path = here;
+        break;
+      }
+      if (index == node->size()) node->push_back(Json::object());
+      node = &(*node)[index];
+      path = here;
+    } else if (node->is_array()) {
+      override_fail(shown, path + " is an array: index it by number (" + path + "[0]." + step.key + " or " + path +
+                               ".0." + step.key + "), not by " + quote(step.key));
+    } else if (node->is_object()) {
+      override_fail(shown, (path.empty() ? std::string("the scene") : path) + " is an object: " +
+                               quote("[" + step.key + "]") + " indexes an array; write " + join_key(path, step.key));
+    } else {
+      override_fail(shown,
+                    path + " is " + describe(*node) + ", not an object or array, so it has no key " + quote(step.key));
+    }
+  }
+  if (log) log("--set " + path + (remove ? ": removed" : " = " + shortened(value.dump())));
+  return path;
+}
+
+// "mesh.max_vertices": the largest vertex count the scene may have (default kDefaultMaxVertices),
+// read first so that no mesh (nor obstacle OBJ) larger than that is ever allocated.
+long long read_max_vertices(const Reader& r, const Json& root) {
+  const Json* mesh = r.find(root, "mesh");
+  if (mesh == nullptr || !mesh->is_object()) return kDefaultMaxVertices;
+  const Json* v = r.find(*mesh, "max_vertices");
+  return v == nullptr ? kDefaultMaxVertices : r.integer_at_least(*v, "mesh.max_vertices", 3);
+}
+
+// Fails at `path` if a generated mesh would have more than `max_vertices` vertices (`count`,
+// computed in 64 bits by the caller before anything is allocated).
+void check_vertex_count(const Reader& r, const std::string& path, const std::string& what, long long count,
+                        long long max_vertices) {
+  if (count > max_vertices)
+    r.fail(path, what + " has " + std::to_string(count) + " vertices, more than mesh.max_vertices = " +
+                     std::to_string(max_vertices) + " (raise mesh.max_vertices to allow it)");
+}
+
+TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log,
+                         long long max_vertices) {
   const std::string path = "mesh";
   if (!j.is_object()) r.fail(path, "expected an object (got " + describe(j) + ")");
   const bool has_obj = j.contains("obj");
@@ -342,16 +527,19 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
     r.fail(path, "needs \"obj\" (a file) or \"primitive\" (allowed: \"grid\", \"cylinder\")");
 
   if (has_obj) {
-    r.check_object(j, path, {"obj", "rotate", "translate"});  // (the placement is read by build_mesh)
+    r.check_object(j, path, {"obj", "rotate", "translate", "max_vertices"});  // (the others: build_mesh)
     const std::string key = "mesh.obj";
     const std::string name = r.string(j["obj"], key);
     if (name.empty()) r.fail(key, "expected a non-empty file path");
     const std::filesystem::path obj = folder / name;
     try {
-      TriMesh mesh = read_obj(obj.string());
+      TriMesh mesh = read_obj(obj.string(), max_vertices);
       log("mesh: " + obj.string() + ": " + std::to_string(mesh.num_vertices()) + " vertices, " +
           std::to_string(mesh.num_triangles()) + " triangles");
       return mesh;
+    } catch (const MeshLimitError& e) {
+      r.fail(key, std::string(e.what()) + " (mesh.max_vertices = " + std::to_string(max_vertices) +
+                      "; raise it to read larger meshes)");
     } catch (const std::exception& e) {
       r.fail(key, e.what());
     }
@@ -361,18 +549,22 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
   TriMesh mesh;
   try {
     if (primitive == "grid") {
-      r.check_object(j, path, {"primitive", "size", "divisions", "rotate", "translate"});
+      r.check_object(j, path, {"primitive", "size", "divisions", "rotate", "translate", "max_vertices"});
       const Json& size = r.sized_array(r.require(j, path, "size"), "mesh.size", 2, "numbers");
       const Json& div = r.sized_array(r.require(j, path, "divisions"), "mesh.divisions", 2, "integers");
       const double sx = r.positive(size[0], "mesh.size[0]", "[m]");
       const double sy = r.positive(size[1], "mesh.size[1]", "[m]");
       const int dx = r.integer_at_least(div[0], "mesh.divisions[0]", 1);
       const int dy = r.integer_at_least(div[1], "mesh.divisions[1]", 1);
+      check_vertex_count(r, "mesh.divisions", "a " + std::to_string(dx) + " x " + std::to_string(dy) + " grid",
+                         (static_cast<long long>(dx) + 1) * (static_cast<long long>(dy) + 1), max_vertices);
       mesh = make_grid(sx, sy, dx, dy);
       log("mesh: grid " + format_number(sx) + " m x " + format_number(sy) + " m, " + std::to_string(dx) +
           " x " + std::to_string(dy) + " divisions");
     } else {
-      r.check_object(j, path, {"primitive", "radius", "length", "segments", "rings", "angle_deg", "rotate", "translate"});
+      r.check_object(j, path,
+                     {"primitive", "radius", "length", "segments", "rings", "angle_deg", "rotate", "translate",
+                      "max_vertices"});
       const double radius = r.positive(r.require(j, path, "radius"), "mesh.radius", "[m]");
       const double length = r.positive(r.require(j, path, "length"), "mesh.length", "[m]");
       double angle = 360.0;
@@ -382,6 +574,10 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
       }
       const int segments = r.integer_at_least(r.require(j, path, "segments"), "mesh.segments", angle < 360.0 ? 1 : 3);
       const int rings = r.integer_at_least(r.require(j, path, "rings"), "mesh.rings", 2);
+      check_vertex_count(r, "mesh", "a cylinder" + std::string(angle < 360.0 ? " panel" : "") + " of " +
+                                        std::to_string(segments) + " segments x " + std::to_string(rings) + " rings",
+                         (static_cast<long long>(segments) + (angle < 360.0 ? 1 : 0)) * static_cast<long long>(rings),
+                         max_vertices);
       mesh = angle < 360.0 ? make_cylinder_panel(radius, length, angle, segments, rings)
                            : make_cylinder(radius, length, segments, rings);
       log("mesh: cylinder r = " + format_number(radius) + " m, L = " + format_number(length) + " m, " +
@@ -398,9 +594,11 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
 
 // The mesh with its optional placement: "rotate": {"axis": [x, y, z], "angle_deg": a} about the
 // origin, then "translate": [x, y, z] [m].
-TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log) {
+TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log,
+                   long long max_vertices) {
   if (!j.is_object()) r.fail("mesh", "expected an object (got " + describe(j) + ")");
   Json shape = j;
+  shape.erase("max_vertices");  // (read by read_max_vertices)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   if (const Json* rot = r.find(j, "rotate")) {
@@ -415,10 +613,13 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
     translation = r.vec3(*tr, "mesh.translate");
     shape.erase("translate");
   }
-  TriMesh mesh = build_mesh_shape(r, shape, folder, log);
+  TriMesh mesh = build_mesh_shape(r, shape, folder, log, max_vertices);
   if (j.contains("rotate") || j.contains("translate")) {
     for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
       mesh.vertices.row(v) = (rotation * mesh.vertices.row(v).transpose() + translation).transpose();
+    if (!mesh.vertices.allFinite())
+      r.fail(j.contains("translate") ? "mesh.translate" : "mesh.rotate",
+             "the placed mesh has a coordinate beyond the range of a double (overflow)");
     log("mesh: placed (rotated, then translated)");
   }
   return mesh;
@@ -764,7 +965,7 @@ void read_collision(const Reader& r, const Json* j, Problem& problem, bool& leve
 
 // "obstacles": [{"name", "primitive" | "obj", shape parameters, "friction", "motion"}].
 std::vector<Obstacle> read_obstacles(const Reader& r, const Json* j, double default_friction,
-                                     const std::filesystem::path& folder, const LogFn& log) {
+                                     const std::filesystem::path& folder, const LogFn& log, long long max_vertices) {
   std::vector<Obstacle> out;
   if (j == nullptr) return out;
   r.array(*j, "obstacles");
@@ -846,8 +1047,11 @@ std::vector<Obstacle> read_obstacles(const Reader& r, const Json* j, double defa
         o.file = name;
         const std::filesystem::path obj = folder / name;
         try {
-          o.mesh = read_obj(obj.string());
+          o.mesh = read_obj(obj.string(), max_vertices);
           check_triangles(o.mesh);
+        } catch (const MeshLimitError& e) {
+          r.fail(key("obj"), std::string(e.what()) + " (mesh.max_vertices = " + std::to_string(max_vertices) +
+                                 ", which limits obstacle meshes too; raise it to read larger ones)");
         } catch (const std::exception& e) {
           r.fail(key("obj"), e.what());
         }
@@ -990,25 +1194,165 @@ RenderSettings render_settings_from_json(const Json& render, const std::string& 
 
 namespace {
 Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::path& file, const LogFn& log);
+
+// Applies the --set overrides to the parsed scene in order, then reads it; errors at or around an
+// overridden key name the override.
+Scene load_overridden(Json root, Reader& r, const std::filesystem::path& file, const LogFn& log,
+                      const std::vector<std::string>& overrides) {
+  std::vector<std::pair<std::string, std::string>> written;
+  for (const std::string& argument : overrides)
+    written.emplace_back(apply_override(root, argument, log), shortened(argument));
+  r.set_overrides(std::move(written));
+  Scene scene = load_scene_json(root, r, file, log);
+  scene.overrides = overrides;
+  return scene;
+}
 }  // namespace
 
-Scene load_scene(const std::filesystem::path& file, const LogFn& log) {
-  const Reader r(file.string());
-  return load_scene_json(parse_file(r, file), r, file, log);
+Scene load_scene(const std::filesystem::path& file, const LogFn& log, const std::vector<std::string>& overrides) {
+  Reader r(file.string());
+  return load_overridden(parse_file(r, file), r, file, log, overrides);
 }
 
-Scene load_scene_text(const std::string& text, const std::filesystem::path& file, const LogFn& log) {
-  const Reader r(file.string());
-  return load_scene_json(parse_text(r, text), r, file, log);
+Scene load_scene_text(const std::string& text, const std::filesystem::path& file, const LogFn& log,
+                      const std::vector<std::string>& overrides) {
+  Reader r(file.string());
+  return load_overridden(parse_text(r, text), r, file, log, overrides);
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
+  const std::size_t n = a.size(), m = b.size();
+  // Rows i-2, i-1 and i of the (n+1) x (m+1) table.
+  std::vector<std::size_t> before(m + 1), previous(m + 1), current(m + 1);
+  for (std::size_t j = 0; j <= m; ++j) previous[j] = j;
+  for (std::size_t i = 1; i <= n; ++i) {
+    current[0] = i;
+    for (std::size_t j = 1; j <= m; ++j) {
+      const bool same = lower(a[i - 1]) == lower(b[j - 1]);
+      current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (same ? 0 : 1)});
+      if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) && lower(a[i - 2]) == lower(b[j - 1]))
+        current[j] = std::min(current[j], before[j - 2] + 1);
+    }
+    std::swap(before, previous);
+    std::swap(previous, current);
+  }
+  return previous[m];
+}
+
+std::string closest_name(const std::string& given, const std::vector<std::string>& allowed) {
+  std::string best;
+  std::size_t best_distance = std::numeric_limits<std::size_t>::max();
+  for (const std::string& name : allowed) {
+    if (name == given) return "";  // not a typo
+    const std::size_t longer = std::max(name.size(), given.size());
+    const std::size_t shorter = std::min(name.size(), given.size());
+    if (3 * (longer - shorter) > longer) continue;  // too far apart in length alone (and cheap to skip)
+    const std::size_t d = edit_distance(given, name);
+    if (3 * d <= longer && d < best_distance) {
+      best = name;
+      best_distance = d;
+    }
+  }
+  return best;
 }
 
 namespace {
+// Logs a warning if the mesh has cracks (find_cracks): distinct border vertices at one position.
+void warn_about_cracks(const TriMesh& mesh, bool from_obj, const LogFn& log) {
+  const std::vector<std::pair<int, int>> cracks = find_cracks(mesh);
+  if (cracks.empty()) return;
+  std::string examples;
+  const std::size_t shown = std::min<std::size_t>(cracks.size(), 3);
+  for (std::size_t i = 0; i < shown; ++i) {
+    const auto [a, b] = cracks[i];
+    examples += (i > 0 ? "; " : "") + std::string("vertices ") + std::to_string(a) + " and " + std::to_string(b) +
+                (from_obj ? " (OBJ indices " + std::to_string(a + 1) + " and " + std::to_string(b + 1) + ")" : "") +
+                " at " + format_point(mesh.vertices.row(a).transpose());
+  }
+  log("warning: mesh: " + std::to_string(cracks.size()) +
+      (cracks.size() == 1 ? " pair" : " pairs") + " of distinct border vertices at the same position (within " +
+      format_number(kCrackTolerance) + " of the mesh's size): " + examples +
+      (cracks.size() > shown ? "; ..." : "") +
+      ". The surface is split there (a crack of border edges) and the cloth will come apart along it; "
+      "merge the vertices in the mesh file if it should be connected (a cut made on purpose is fine)");
+}
+
+// A number for a message, to 3 significant digits ("1.41e+304", "0.25"); "inf" past the doubles.
+std::string approx(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.3g", v);
+  return buffer;
+}
+
+// Loads so large that no shell could carry them are errors naming the key. The estimate is the
+// membrane strain they would cause if carried by stretching alone, the stiffest way a shell can
+// carry a load: force per unit width over the stretch modulus E·t, with L the mesh's
+// bounding-box diagonal — (|pressure|, |surface_load| or areal density·|gravity|)·L, |F|/L for a
+// point load, |M|/L² for a couple, summed. Above kMaxLoadStrain it is an error, above 1 (100 %)
+// a warning (far beyond the linear-elastic model). Gravity above 1e4 g is an error in any case.
+constexpr double kMaxLoadStrain = 100.0;
+constexpr double kMaxGravity = 1e4 * 9.80665;  // [m/s²]
+
+void check_load_magnitudes(const Reader& r, const Problem& p, const LogFn& log) {
+  if (const double g = p.gravity.stableNorm(); g > kMaxGravity)
+    r.fail("loads.gravity", "|g| = " + approx(g) + " m/s² is more than 1e4 g (" + approx(kMaxGravity) +
+                                " m/s²); check the value and its unit [m/s²]");
+  const Eigen::MatrixX3d& v = p.mesh.vertices;
+  if (v.rows() == 0) return;
+  const Eigen::Vector3d half = (v.colwise().maxCoeff() / 2 - v.colwise().minCoeff() / 2).transpose();
+  const double size = 2 * half.stableNorm();          // L [m]
+  const double stretch = p.material.stretch_modulus;  // E·t [N/m]
+  struct Term {
+    std::string key, value, formula;  // "loads.pressure", "1e+308 N/m²", "|p|·L"
+    double strain;
+  };
+  std::vector<Term> terms;
+  auto add = [&](std::string key, std::string value, std::string formula, double strain) {
+    terms.push_back({std::move(key), std::move(value), std::move(formula), std::isnan(strain) ? HUGE_VAL : strain});
+  };
+  if (const double w = p.material.areal_density * p.gravity.stableNorm(); w > 0)
+    add("loads.gravity", approx(p.gravity.stableNorm()) + " m/s²", "areal density·|g|·L", w / stretch * size);
+  if (const double s = p.surface_load.stableNorm(); s > 0)
+    add("loads.surface_load", approx(s) + " N/m²", "|surface_load|·L", s / stretch * size);
+  if (const double s = std::abs(p.pressure); s > 0)
+    add("loads.pressure", approx(p.pressure) + " N/m²", "|p|·L", s / stretch * size);
+  for (std::size_t i = 0; i < p.point_loads.size(); ++i)
+    if (const double f = p.point_loads[i].force.stableNorm(); f > 0)
+      add(join_key(join_index("loads.point_loads", i), "force"), "|F| = " + approx(f) + " N", "|F|/L",
+          f / size / stretch);
+  for (std::size_t i = 0; i < p.moments.size(); ++i)
+    if (const double m = p.moments[i].moment.stableNorm(); m > 0)
+      add(join_key(join_index("loads.moments", i), "moment"), "|M| = " + approx(m) + " N·m", "|M|/L²",
+          m / size / size / stretch);
+  if (terms.empty()) return;
+  double total = 0;
+  const Term* largest = &terms.front();
+  for (const Term& t : terms) {
+    total += t.strain;
+    if (t.strain > largest->strain) largest = &t;
+  }
+  const std::string estimate =
+      largest->value + ": even carried by stretching alone (the stiffest way a shell carries a load) the scene's "
+      "loads would strain the sheet by about " + approx(total) + " (force per unit width, here " + largest->formula +
+      ", over the stretch modulus E·t = " + approx(stretch) + " N/m; L = " + approx(size) +
+      " m, the mesh's bounding-box diagonal)";
+  if (!(total <= kMaxLoadStrain))
+    r.fail(largest->key, estimate + ", more than " + approx(kMaxLoadStrain) +
+                             " (10000 %): refused; check the value and its unit");
+  if (total > 1)
+    log("warning: " + largest->key + ": " + estimate +
+        ", more than 1 (100 %): far beyond the range of the linear-elastic model");
+}
+
 Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::path& file, const LogFn& log) {
   const LogFn say = log ? log : LogFn([](const std::string&) {});
   r.check_object(root, "",
                  {"name", "description", "analysis", "method", "mesh", "material", "boundary", "loads", "probes",
                   "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render",
-                  "collision", "obstacles", "imperfection"});
+                  "collision", "obstacles", "imperfection", "$schema"});
+  // "$schema": the JSON Schema the file follows (scenes/scene.schema.json), for editors; ignored.
+  if (const Json* schema = r.find(root, "$schema")) r.string(*schema, "$schema");
 
   Scene scene;
   scene.file = file;
@@ -1039,7 +1383,8 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   // The discretisation: it decides how the mesh is prepared, so it is read before the mesh.
   if (const Json* m = r.find(root, "method")) scene.problem.method = r.choice(*m, "method", discretization_methods(), "method");
 
-  // Cheap checks first, the mesh (possibly large) after.
+  // Cheap checks first, the mesh (possibly large) after; nothing larger than this is read or made.
+  const long long max_vertices = read_max_vertices(r, root);
   scene.problem.material = read_material(r, r.find(root, "material"));
   scene.problem.quadrature = read_numerics(r, r.find(root, "numerics"));
   Problem& dyn = scene.problem;
@@ -1062,17 +1407,25 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
     // Contact acts on the surface that is drawn, unless the scene says otherwise.
     if (!level_given) scene.problem.collision_level = scene.render.refine;
     scene.problem.obstacles =
-        read_obstacles(r, r.find(root, "obstacles"), scene.problem.collision.friction, file.parent_path(), say);
+        read_obstacles(r, r.find(root, "obstacles"), scene.problem.collision.friction, file.parent_path(), say,
+                       max_vertices);
   }
-  TriMesh mesh = build_mesh(r, r.require(root, "", "mesh"), file.parent_path(), say);
+  const Json& mesh_json = r.require(root, "", "mesh");
+  TriMesh mesh = build_mesh(r, mesh_json, file.parent_path(), say, max_vertices);
+  warn_about_cracks(mesh, mesh_json.contains("obj"), say);
   try {
     scene.problem.mesh = prepare_mesh(scene.problem.method, mesh, say);
   } catch (const std::exception& e) {
     r.fail("mesh", e.what());
   }
+  if (scene.problem.mesh.num_vertices() > max_vertices)
+    r.fail("mesh", "prepared for the method (refined once by Loop subdivision) it has " +
+                       std::to_string(scene.problem.mesh.num_vertices()) + " vertices, more than mesh.max_vertices = " +
+                       std::to_string(max_vertices) + " (raise mesh.max_vertices to allow it)");
 
   scene.problem.boundary = read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, dynamic, say);
   read_loads(r, r.find(root, "loads"), scene.problem, dynamic ? &dyn.ramp_time : nullptr, say);
+  check_load_magnitudes(r, scene.problem, say);
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
   // The boundary and probes were selected on the mesh as placed; the imperfection then changes
   // its rest shape by at most the amplitude.

@@ -77,12 +77,32 @@ struct Scene {
 };
 
 // Reads, validates and builds the scene in `file`; relative mesh paths are resolved against the
-// file's folder. Log lines (mesh preparation, selection sizes) go to `log`, which may be empty.
-// Throws SceneError.
-Scene load_scene(const std::filesystem::path& file, const LogFn& log);
+// file's folder. Log lines (mesh preparation, selection sizes, warnings) go to `log`, which may be
+// empty. Throws SceneError.
+//
+// `overrides` are `clothsim --set` arguments "key.path=value", applied in order to the parsed file
+// before it is read, so that an overridden scene is checked exactly like a file: the value is
+// JSON if it parses as JSON and otherwise the text as a string (`time.end=0.5`, `name=foo`,
+// `render.camera.eye=[1,2,3]`); `null` removes the key (or array element). Array elements are
+// indexed `boundary[0].rotation` or `boundary.0.rotation`; an index equal to the length appends.
+// Missing objects on the way are created. A malformed argument, a key below a number or string,
+// or an index out of range throws SceneError("--set <argument>: ..."); a problem the loader
+// finds at (or inside, or around) an overridden key ends "(set by --set <argument>)".
+Scene load_scene(const std::filesystem::path& file, const LogFn& log,
+                 const std::vector<std::string>& overrides = {});
 // The same for a scene given as JSON text (a study's variant of a scene file): `file` names the
 // scene in error messages, and relative OBJ paths are resolved against its folder.
-Scene load_scene_text(const std::string& text, const std::filesystem::path& file, const LogFn& log);
+Scene load_scene_text(const std::string& text, const std::filesystem::path& file, const LogFn& log,
+                      const std::vector<std::string>& overrides = {});
+
+// Edit distance between `a` and `b` (insertions, deletions, substitutions and swaps of adjacent
+// characters each count 1; letters compared case-insensitively).
+std::size_t edit_distance(const std::string& a, const std::string& b);
+// The name in `allowed` closest to `given` by edit_distance if it is close enough to be a typo
+// (distance at most a third of the longer name's length; the first of equally close names), or
+// "" (also when `given` is itself allowed). Scene errors for unknown keys and values end with
+// "; did you mean \"<name>\"?" when there is one.
+std::string closest_name(const std::string& given, const std::vector<std::string>& allowed);
 
 // Index of the row of `vertices` [m] nearest to `point` [m] (Euclidean; ties → lowest index),
 // or -1 if there are no vertices.
