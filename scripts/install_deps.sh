@@ -6,7 +6,7 @@ packages=(
   cmake g++ make pkg-config
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libpng-dev libosmesa6-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libcgal-dev
-  python3-minimal python3-matplotlib
+  python3-minimal python3-matplotlib python3-jsonschema
 )
 missing=()
 for p in "${packages[@]}"; do
