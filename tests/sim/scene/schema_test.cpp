@@ -1,6 +1,7 @@
 // The JSON Schema of the scene format (scenes/scene.schema.json) against the scene loader:
 // - scripts/check_schema.py validates every shipped scene and the cases of schema_cases.json
 //   with python3-jsonschema (valid cases must validate, invalid ones must not);
+//   and the scenes the stability study generates;
 // - the loader gives the same verdicts on those cases, and names the case's key in its error;
 // - every object of the schema has exactly the keys the loader allows at that place (the loader
 //   lists them when it meets an unknown key), and every enumeration exactly the loader's values.
@@ -8,6 +9,7 @@
 
 #include "sim/setup/setup.hpp"
 #include "sim/shell/material_presets.hpp"
+#include "sim/study/stability.hpp"
 
 #include "tests/support/process.hpp"
 
@@ -101,6 +103,30 @@ TEST(SceneSchema, ShippedScenesAndCasesValidateWithPythonJsonschema) {
   fs::remove_all(dir);
   EXPECT_EQ(code, 0) << out;
   EXPECT_NE(out.find("agree with"), std::string::npos) << out;
+}
+
+TEST(SceneSchema, StabilityStudyScenesValidate) {
+  // The scenes `clothsim study stability` writes and runs (with and without their remedies).
+  const fs::path dir = testing::make_temp_dir("clothsim_schema_");
+  int written = 0;
+  for (const StabilityCase& c : stability_cases(false)) {
+    std::ofstream(dir / (c.name + ".json")) << c.scene_json;
+    ++written;
+    if (!c.without_remedy_json.empty()) {
+      std::ofstream(dir / (c.name + "_without_remedy.json")) << c.without_remedy_json;
+      ++written;
+    }
+  }
+  ASSERT_GT(written, 10);
+  const std::string command = "/usr/bin/python3 " + testing::shell_quote((kSource / "scripts/check_schema.py").string()) +
+                              " " + testing::shell_quote((kSource / "scenes/scene.schema.json").string()) + " " +
+                              testing::shell_quote(dir.string()) + " > " + testing::shell_quote((dir / "out.txt").string()) +
+                              " 2>&1";
+  const int code = testing::run_shell(command);
+  const std::string out = testing::read_file_bytes(dir / "out.txt");
+  fs::remove_all(dir);
+  EXPECT_EQ(code, 0) << out;
+  EXPECT_NE(out.find(std::to_string(written) + " scene file(s)"), std::string::npos) << out;
 }
 
 TEST(SceneSchema, CheckerFailsOnABadScene) {
