@@ -166,6 +166,7 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                    {"max_solver_iterations", totals.max_solver_iterations},
                    {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)},
                    {"render", render_settings_json(scene.render)},
+                   {"overrides", scene.overrides},
                    {"warnings", warnings},
                    {"status", status}};
   if (scene.problem.has_contact())

@@ -58,6 +58,7 @@ std::string result_json(const Scene& scene, const StaticResult& result) {
                      {"vertices", scene.problem.mesh.num_vertices()},
                      {"dofs", result.dofs},
                      {"seconds", {{"assemble", result.assemble_seconds}, {"solve", result.solve_seconds}}},
+                     {"overrides", scene.overrides},
                      {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)},
                      {"render", render_settings_json(scene.render)}};
   return out.dump(2) + "\n";

@@ -75,6 +75,11 @@ TEST_F(SetOption, OverridesReachTheRunsOutputs) {
             0)
       << err_;
   EXPECT_NEAR(tip_deflection("strip3") / base, 3.0, 1e-9);
+  // result.json records the overrides, in order.
+  const auto result = nlohmann::json::parse(read_file_bytes(out_ / "strip3" / "result.json"));
+  EXPECT_EQ(result["overrides"], nlohmann::json::array({"name=strip3", "loads.point_loads.0.force=[0,0,-0.004]",
+                                                        "loads.point_loads.0.force=[0,0,-0.003]"}));
+  EXPECT_EQ(nlohmann::json::parse(read_file_bytes(out_ / "strip" / "result.json"))["overrides"], nlohmann::json::array());
   // The scene file is unchanged.
   EXPECT_EQ(read_file_bytes(scene_), kStrip);
 }
