@@ -7,9 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,8 +18,6 @@
 #include <system_error>
 #include <thread>
 #include <vector>
-
-extern char** environ;
 
 namespace clothsim {
 namespace {
@@ -65,22 +61,6 @@ class OutputSafetyTest : public ::testing::Test {
   fs::path dir_;
 };
 
-pid_t spawn_clothsim(const std::vector<std::string>& args, const fs::path& err) {
-  std::vector<std::string> words = {CLOTHSIM_BINARY};
-  words.insert(words.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = -1;
-  const int error = posix_spawn(&pid, CLOTHSIM_BINARY, &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return error == 0 ? pid : -1;
-}
-
 // Hidden temporaries (".*tmp*") anywhere under `dir`.
 std::vector<std::string> temporaries(const fs::path& dir) {
   std::vector<std::string> found;
@@ -94,7 +74,7 @@ std::vector<std::string> temporaries(const fs::path& dir) {
 TEST_F(OutputSafetyTest, ASecondRunIntoAFolderInUseIsRefusedNamingThePid) {
   const fs::path scene = write_scene(0.6);
   const fs::path out = dir_ / "out";
-  const pid_t first = spawn_clothsim({scene.string(), "--out", out.string(), "--no-render"}, dir_ / "first.txt");
+  const pid_t first = testing::spawn_process(CLOTHSIM_BINARY, {scene.string(), "--out", out.string(), "--no-render"}, dir_ / "first.txt");
   ASSERT_GT(first, 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   while (!fs::exists(out / "hang" / "summary.json") && std::chrono::steady_clock::now() < deadline)

@@ -8,11 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <fcntl.h>
 
 #include <chrono>
 #include <filesystem>
@@ -24,8 +21,6 @@
 #include <system_error>
 #include <thread>
 #include <vector>
-
-extern char** environ;
 
 namespace clothsim {
 namespace {
@@ -112,19 +107,7 @@ class ResumeTest : public ::testing::Test {
 
   // Starts clothsim in the background; its PID.
   pid_t spawn(const std::vector<std::string>& args) const {
-    std::vector<std::string> words = {CLOTHSIM_BINARY};
-    words.insert(words.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (std::string& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-    posix_spawn_file_actions_addopen(&actions, 2, (dir_ / "spawned.txt").c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    pid_t pid = -1;
-    const int error = posix_spawn(&pid, CLOTHSIM_BINARY, &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    return error == 0 ? pid : -1;
+    return testing::spawn_process(CLOTHSIM_BINARY, args, dir_ / "spawned.txt");
   }
 
   // Waits until `ready()` holds (polling), at most 120 s; false if the process ended first.
