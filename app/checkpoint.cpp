@@ -49,7 +49,7 @@ class Reader {
     const auto n = get<std::uint64_t>();
     if (n > (bytes_.size() - at_) / sizeof(double)) fail("a vector longer than the file");
     Eigen::VectorXd v(static_cast<Eigen::Index>(n));
-    std::memcpy(v.data(), bytes_.data() + at_, n * sizeof(double));
+    if (n > 0) std::memcpy(v.data(), bytes_.data() + at_, n * sizeof(double));  // an empty v has data() == nullptr
     at_ += n * sizeof(double);
     return v;
   }
