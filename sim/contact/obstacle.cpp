@@ -113,8 +113,10 @@ TriMesh round_mesh(const Eigen::Vector3d& from, const Eigen::Vector3d& to, doubl
   // The side: straight, with rings no farther apart than the segment length (better-shaped
   // triangles; they do not change the surface).
   const double length = (to - from).norm();
-  // (At most 200 rings along a long, thin body: the rings only shape the triangles.)
-  const int along = std::clamp(static_cast<int>(std::ceil(length / (2.0 * M_PI * r / n))), 1, 200);
+  // (At most 200 rings along a long, thin body: the rings only shape the triangles. Clamped before
+  // the conversion: the count for a 1e120 m capsule does not fit an int.)
+  const double wanted = std::ceil(length / (2.0 * M_PI * r / n));
+  const int along = wanted >= 200.0 ? 200 : wanted >= 1.0 ? static_cast<int>(wanted) : 1;
   for (int k = 1; k <= along; ++k) rings.push_back(ring(from + (length * k / along) * axis, r));
   for (int k = 1; k < cap_rings; ++k) {
     const double phi = 0.5 * M_PI * k / cap_rings;
