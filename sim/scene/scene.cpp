@@ -48,8 +48,9 @@ std::string join_index(const std::string& path, std::size_t index) {
   return path + "[" + std::to_string(index) + "]";
 }
 
-// A string as a JSON string literal (quoted, escaped).
-std::string quote(const std::string& s) { return Json(s).dump(); }
+// A string as a JSON string literal (quoted, escaped). Bytes that are not UTF-8 (a file name, a
+// long string cut inside a character by describe) become U+FFFD: dump() would throw.
+std::string quote(const std::string& s) { return Json(s).dump(-1, ' ', false, Json::error_handler_t::replace); }
 
 // A double in its shortest round-trip form.
 std::string format_number(double v) { return Json(v).dump(); }

@@ -181,5 +181,26 @@ TEST(FuzzFindings, VeryLongCapsuleHasTheMostRingsNotOne) {
   EXPECT_LT(tessellate(capsule).num_triangles(), rings_200);
 }
 
+// fuzz_scene's second finding (fuzz/regressions/scene/long_string_cut_inside_a_character.json): a
+// scene that is a string longer than 40 bytes is described by its first 40 bytes, and when byte
+// 40 fell inside a UTF-8 character, quoting that cut string threw nlohmann's type_error 316
+// instead of the SceneError. The same for a file name that is not UTF-8, quoted when it is not a
+// safe scene name.
+TEST_F(FuzzInputs, MessagesQuoteBytesThatAreNotUtf8) {
+  const std::string cut = "\"" + std::string(39, 'a') + "\u0651 and more\"";  // U+0651: bytes 40 and 41
+  try {
+    load_scene_text(cut, dir_ / "scene.json", nullptr);
+    ADD_FAILURE() << "loaded";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("expected a JSON object at the top level"), std::string::npos) << e.what();
+  }
+  try {
+    load_scene_text(R"({"mesh": {"primitive": "grid", "size": [1, 1], "divisions": [2, 2]}})", dir_ / "\xff\xfe.json", nullptr);
+    ADD_FAILURE() << "loaded";
+  } catch (const SceneError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a safe folder name"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace clothsim
