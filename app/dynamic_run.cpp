@@ -150,6 +150,24 @@ std::vector<std::string> settings_warnings(const Scene& scene, int steps) {
 }
 
 
+// The linear solver the run used: the scene's settings with "auto" resolved as the simulator
+// resolves it (LinearSolver's constructor, for 3 unknowns per control vertex).
+OrderedJson solver_json(const Problem& problem) {
+  const LinearSolverSettings& given = problem.solver;
+  const LinearSolverSettings used = resolve_automatic(given, 3 * static_cast<Eigen::Index>(problem.mesh.num_vertices()));
+  OrderedJson j = {{"type", to_string(used.type)}};
+  if (used.type == LinearSolverType::pcg) {
+    j["preconditioner"] = to_string(used.preconditioner);
+    j["tolerance"] = used.tolerance;
+  }
+  OrderedJson automatic = OrderedJson::array();
+  if (given.type == LinearSolverType::automatic) automatic.push_back("type");
+  if (used.type == LinearSolverType::pcg && given.preconditioner == PreconditionerType::automatic)
+    automatic.push_back("preconditioner");
+  j["chosen_automatically"] = automatic;
+  return j;
+}
+
 std::string summary_json(const Scene& scene, const RunTotals& totals, double wall_seconds,
                          const std::vector<std::string>& warnings, const std::string& status,
                          const std::string& error) {
@@ -164,6 +182,7 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                      {"solve", totals.solve_ms / 1000.0}}},
                    {"frames", totals.frames},
                    {"max_solver_iterations", totals.max_solver_iterations},
+                   {"solver", solver_json(scene.problem)},
                    {"drawn_surface", drawn_surface_json(scene.problem.method, scene.render)},
                    {"render", render_settings_json(scene.render)},
                    {"overrides", scene.overrides},

@@ -877,9 +877,12 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   r.check_object(*j, "solver",
                  {"type", "tolerance", "max_iterations", "newton_iterations", "preconditioner", "refresh_iterations",
                   "tension_stiffening", "warm_start"});
-  if (const Json* v = r.find(*j, "type"))
-    s.type = r.choice(*v, "solver.type", {"pcg", "cholmod"}, "solver type") == "cholmod" ? LinearSolverType::cholmod
-                                                                                      : LinearSolverType::pcg;
+  if (const Json* v = r.find(*j, "type")) {
+    const std::string type = r.choice(*v, "solver.type", {"auto", "pcg", "cholmod"}, "solver type");
+    s.type = type == "cholmod" ? LinearSolverType::cholmod
+             : type == "pcg"   ? LinearSolverType::pcg
+                               : LinearSolverType::automatic;
+  }
   if (const Json* v = r.find(*j, "tolerance")) {
     s.tolerance = r.number(*v, "solver.tolerance");
     if (!(s.tolerance > 0 && s.tolerance < 1))
@@ -888,10 +891,12 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   if (const Json* v = r.find(*j, "max_iterations")) s.max_iterations = r.integer_at_least(*v, "solver.max_iterations", 1);
   if (const Json* v = r.find(*j, "newton_iterations"))
     s.newton_iterations = r.integer_at_least(*v, "solver.newton_iterations", 1);
-  if (const Json* v = r.find(*j, "preconditioner"))
-    s.preconditioner = r.choice(*v, "solver.preconditioner", {"block_jacobi", "cholesky"}, "preconditioner") == "cholesky"
-                           ? PreconditionerType::cholesky
-                           : PreconditionerType::block_jacobi;
+  if (const Json* v = r.find(*j, "preconditioner")) {
+    const std::string p = r.choice(*v, "solver.preconditioner", {"auto", "block_jacobi", "cholesky"}, "preconditioner");
+    s.preconditioner = p == "cholesky"       ? PreconditionerType::cholesky
+                       : p == "block_jacobi" ? PreconditionerType::block_jacobi
+                                             : PreconditionerType::automatic;
+  }
   if (const Json* v = r.find(*j, "refresh_iterations"))
     s.refresh_iterations = r.integer_at_least(*v, "solver.refresh_iterations", 1);
   if (const Json* v = r.find(*j, "tension_stiffening")) s.tension_stiffening = r.boolean(*v, "solver.tension_stiffening");

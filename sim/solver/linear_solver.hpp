@@ -16,19 +16,31 @@
 
 namespace clothsim {
 
-enum class LinearSolverType { pcg, cholmod };
+// `automatic` (the default of both) is resolved by resolve_automatic() from the size of the
+// system; the LinearSolver resolves it on construction.
+enum class LinearSolverType { automatic, pcg, cholmod };
 enum class PreconditionerType {
+  automatic,
   block_jacobi,  // inverse 3 × 3 diagonal blocks
   cholesky,      // a Cholesky factor of an earlier step's matrix, refreshed when PCG slows down
 };
 
 struct LinearSolverSettings {
-  LinearSolverType type = LinearSolverType::pcg;
+  LinearSolverType type = LinearSolverType::automatic;
   double tolerance = 1e-8;    // relative residual of the linear system (pcg)
   int max_iterations = 2000;  // pcg
-  PreconditionerType preconditioner = PreconditionerType::block_jacobi;  // pcg
+  PreconditionerType preconditioner = PreconditionerType::automatic;  // pcg
   int refresh_iterations = 50;  // cholesky preconditioner: refactor after a solve that needed more
 };
+
+// The scene-file names: "auto", "pcg", "cholmod"; "auto", "block_jacobi", "cholesky".
+const char* to_string(LinearSolverType type);
+const char* to_string(PreconditionerType preconditioner);
+
+// `settings` with `automatic` replaced by the choice for a system of `unknowns` rows (3 per
+// vertex); the other fields unchanged. The rule and the measurements behind it:
+// scenes/README.md ("solver") and docs/performance.md ("Automatic solver choice").
+LinearSolverSettings resolve_automatic(const LinearSolverSettings& settings, Eigen::Index unknowns);
 
 struct LinearSolveReport {
   bool converged = false;
@@ -51,7 +63,7 @@ struct LinearSolverCheckpoint {
 
 class LinearSolver {
  public:
-  // `size`: rows of the systems to come.
+  // `size`: rows of the systems to come (`automatic` settings are resolved for it).
   LinearSolver(const LinearSolverSettings& settings, Eigen::Index size);
   ~LinearSolver();
   LinearSolver(const LinearSolver&) = delete;
@@ -70,7 +82,7 @@ class LinearSolver {
   // solve().
   Preconditioner preconditioner(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) const;
 
-  const LinearSolverSettings& settings() const { return settings_; }
+  const LinearSolverSettings& settings() const { return settings_; }  // resolved (never automatic)
 
   // The state that later solves depend on (see LinearSolverCheckpoint).
   LinearSolverCheckpoint checkpoint() const;

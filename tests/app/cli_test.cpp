@@ -2,6 +2,7 @@
 // checks exit codes, error messages, that invalid input leaves no output behind, and the streamed
 // outputs of dynamic runs (also when they fail part-way).
 #include "render/png_io.hpp"
+#include "sim/solver/linear_solver.hpp"
 
 #include "tests/support/process.hpp"
 
@@ -331,6 +332,11 @@ TEST_F(CliTest, DynamicRunWritesOutputs) {
   EXPECT_NEAR(j["simulated_time"].get<double>(), 0.01, 1e-12);
   EXPECT_EQ(j["frames"], 6);
   EXPECT_GE(j["max_solver_iterations"].get<int>(), 1);
+  // The scene names no solver: both choices were automatic, and the summary says what they were.
+  EXPECT_EQ(j["solver"]["type"], "pcg");
+  EXPECT_EQ(j["solver"]["preconditioner"], "cholesky");
+  EXPECT_EQ(j["solver"]["tolerance"].get<double>(), clothsim::LinearSolverSettings().tolerance);
+  EXPECT_EQ(j["solver"]["chosen_automatically"], nlohmann::json::array({"type", "preconditioner"}));
   EXPECT_TRUE(j["wall_seconds"].is_number());
   for (const std::string part : {"rotate", "assemble", "solve"}) EXPECT_TRUE(j["seconds"][part].is_number()) << part;
   EXPECT_TRUE(j["warnings"].is_array());

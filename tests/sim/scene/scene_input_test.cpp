@@ -198,7 +198,7 @@ TEST_F(SceneInput, UnknownKeysAndValuesSuggestTheClosestName) {
   EXPECT_EQ(with(R"("material": {"preset": "silk"})").find("did you mean"), std::string::npos);
   const std::string solver = error(std::string(R"({"analysis": "dynamic", "material": {"preset": "cotton"}, )") + kGrid4 +
                                    R"(, "solver": {"type": "cholmd"}})");
-  EXPECT_TRUE(contains(solver, "solver.type: unknown solver type \"cholmd\" (allowed: \"pcg\", \"cholmod\"); did you mean "
+  EXPECT_TRUE(contains(solver, "solver.type: unknown solver type \"cholmd\" (allowed: \"auto\", \"pcg\", \"cholmod\"); did you mean "
                                "\"cholmod\"?"))
       << solver;
 }

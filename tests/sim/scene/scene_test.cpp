@@ -473,7 +473,8 @@ TEST_F(SceneLoader, DynamicDefaults) {
   EXPECT_DOUBLE_EQ(d.time.output_fps, 30.0);
   EXPECT_DOUBLE_EQ(d.damping.stiffness, 0.0);
   EXPECT_DOUBLE_EQ(d.damping.mass, 0.0);
-  EXPECT_EQ(d.solver.type, LinearSolverType::pcg);
+  EXPECT_EQ(d.solver.type, LinearSolverType::automatic);
+  EXPECT_EQ(d.solver.preconditioner, PreconditionerType::automatic);
   EXPECT_DOUBLE_EQ(d.solver.tolerance, 1e-8);
   EXPECT_EQ(d.solver.max_iterations, 2000);
   EXPECT_EQ(d.solver.newton_iterations, 1);
@@ -536,7 +537,7 @@ TEST_F(SceneLoader, DynamicSettingErrors) {
   EXPECT_EQ(with(R"("damping": {"mass": -1})"), expected("damping.mass: must be >= 0 [1/s] (got -1)"));
   EXPECT_TRUE(contains(with(R"("damping": {"alpha": 1})"), expected("damping.alpha: unknown key (allowed: stiffness, mass)")));
   EXPECT_EQ(with(R"("solver": {"type": "gmres"})"),
-            expected("solver.type: unknown solver type \"gmres\" (allowed: \"pcg\", \"cholmod\")"));
+            expected("solver.type: unknown solver type \"gmres\" (allowed: \"auto\", \"pcg\", \"cholmod\")"));
   EXPECT_EQ(with(R"("solver": {"tolerance": 1})"), expected("solver.tolerance: must be > 0 and < 1 (got 1)"));
   EXPECT_EQ(with(R"("solver": {"tolerance": 0})"), expected("solver.tolerance: must be > 0 and < 1 (got 0)"));
   EXPECT_EQ(with(R"("solver": {"max_iterations": 0})"), expected("solver.max_iterations: must be an integer >= 1 (got 0)"));
@@ -544,7 +545,7 @@ TEST_F(SceneLoader, DynamicSettingErrors) {
             expected("solver.newton_iterations: must be an integer >= 1 (got 0)"));
   EXPECT_TRUE(contains(with(R"("solver": {"max_iterations": 10.5})"), expected("solver.max_iterations: expected an integer")));
   EXPECT_TRUE(contains(with(R"("solver": {"preconditioner": "jacobi"})"),
-                       expected("solver.preconditioner: unknown preconditioner \"jacobi\" (allowed: \"block_jacobi\", \"cholesky\")")));
+                       expected("solver.preconditioner: unknown preconditioner \"jacobi\" (allowed: \"auto\", \"block_jacobi\", \"cholesky\")")));
   EXPECT_TRUE(contains(with(R"("solver": {"precondition": "cholesky"})"),
                        expected("solver.precondition: unknown key (allowed: type, tolerance, max_iterations, "
                                 "newton_iterations, preconditioner, refresh_iterations, tension_stiffening, warm_start)")));
