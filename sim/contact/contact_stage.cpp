@@ -410,17 +410,47 @@ struct ContactStage::Impl {
     return dist;
   }
 
+  // Whether two triangles are within `near` at rest: sharing a vertex, two vertices closer than
+  // `near` (enough, and decides most pairs of a finely refined surface cheaply), or else their
+  // exact distance below it: the exact distance's verdict (a vertex pair bounds it from above,
+  // bounding spheres from below; both only skip the exact test where it could not differ).
+  bool near_pair(const std::array<int, 3>& a, const std::array<int, 3>& b, double near) const {
+    if (shares_vertex(a, b)) return true;
+    const double near2 = near * near;
+    for (int x : a)
+      for (int y : b)
+        if ((rest_points.row(x) - rest_points.row(y)).squaredNorm() < near2) return true;
+    // Bounding spheres about the centroids bound the distance from below.
+    auto sphere = [&](const std::array<int, 3>& t, Eigen::RowVector3d& centre) {
+      centre = (rest_points.row(t[0]) + rest_points.row(t[1]) + rest_points.row(t[2])) / 3.0;
+      double radius = 0.0;
+      for (int x : t) radius = std::max(radius, (rest_points.row(x) - centre).norm());
+      return radius;
+    };
+    Eigen::RowVector3d ca, cb;
+    const double ra = sphere(a, ca), rb = sphere(b, cb);
+    if ((ca - cb).norm() - ra - rb > near * (1.0 + 1e-12)) return false;
+    return triangle_distance(rest_points, a, b) < near;
+  }
+
   void find_near_at_rest() {
     const double near = 2.0 * settings.thickness;
     near_at_rest.assign(surface.triangles.size(), {});
     std::vector<Box> boxes(surface.triangles.size());
     for (size_t t = 0; t < surface.triangles.size(); ++t) boxes[t] = swept_box(rest_points, rest_points, surface.triangles[t], 0.5 * near);
     contact::BroadPhase rest_broad;
-    for (const auto& [a, b] : rest_broad.self_pairs(boxes)) {
-      const auto& ta = surface.triangles[static_cast<size_t>(a)];
-      const auto& tb = surface.triangles[static_cast<size_t>(b)];
-      if (shares_vertex(ta, tb) || triangle_distance(rest_points, ta, tb) < near) near_at_rest[static_cast<size_t>(a)].push_back(b);
-    }  // sorted: the pairs come sorted
+    const std::vector<std::pair<int, int>> pairs = rest_broad.self_pairs(boxes);
+    // The predicate in parallel (one flag per pair), the lists in the pairs' order: the same
+    // lists as a serial pass.
+    std::vector<char> is_near(pairs.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i)
+        is_near[i] = near_pair(surface.triangles[static_cast<size_t>(pairs[i].first)],
+                               surface.triangles[static_cast<size_t>(pairs[i].second)], near);
+    });
+    for (size_t i = 0; i < pairs.size(); ++i)
+      if (is_near[i]) near_at_rest[static_cast<size_t>(pairs[i].first)].push_back(pairs[i].second);
+    // sorted: the pairs come sorted
   }
 
   static bool shares_vertex(const std::array<int, 3>& a, const std::array<int, 3>& b) {
