@@ -8,14 +8,20 @@ docs/convergence.md) and draws one panel for the static plates and one per dynam
 each dynamic case that has the post-buckling columns two more: the relative elastic-energy error at
 the end of the run against wall time (log-log; mesh series solid, time-step series dashed), and the
 fold counts at the end of the run against control vertices (mesh series; circumferential median
-solid, axial median dashed, the reference run's counts as grey horizontal lines). Colour
+solid, axial median dashed, the reference run's counts as grey horizontal lines), and for each
+dynamic case with a tolerance series (rows of series "tolerance") two more: the solver error (the run
+against its setting's tight-tolerance run) against the linear solver's tolerance, log-log, with the
+discretisation error of each setting (its tight run against the reference) as a thin horizontal
+line in the same colour and line style; and the wall time per run (solid, left axis, log) and PCG
+iterations per step (dashed, right axis) against the tolerance. Colour
 = method (the same in every panel, so later baseline methods are new colours), marker and line
 style = plate case (plates panel) or series and error window (dynamic panels: solid = mesh
 refinement at a fixed time step, dashed = time-step refinement on the reference mesh, both with
 filled markers for the first window; dotted and dash-dotted with hollow markers for later
-windows). Plates: thin grey lines mark the relative precision of each published coefficient.
-Rows of the "reference" series, failed runs (error nan) and errors of exactly 0 cannot be drawn
-on a log axis and are left out. Exits with status 3 when matplotlib is missing (Debian:
+windows; in the tolerance panels the marker gives the time step). Plates: thin grey lines mark the
+relative precision of each published coefficient. Rows of the "reference" series, failed runs
+(error nan) and errors of exactly 0 cannot be drawn on a log axis and are left out; the tolerance
+series appears only in its own panels. Exits with status 3 when matplotlib is missing (Debian:
 python3-matplotlib).
 """
 
@@ -59,7 +65,7 @@ def drawable(row):
         error, seconds = float(row["error"]), float(row["wall_seconds"])
     except ValueError:
         return False
-    return row["series"] != "reference" and math.isfinite(error) and error > 0 and seconds > 0
+    return row["series"] not in ("reference", "tolerance") and math.isfinite(error) and error > 0 and seconds > 0
 
 
 def panel_of(case):
@@ -121,7 +127,7 @@ def draw_energy_panel(ax, rows, case, colour):
     curves = {}
     for r in end_state_rows(rows, case):
         error, seconds = number(r, "energy_error"), number(r, "wall_seconds")
-        if r["series"] == "reference" or error is None or error <= 0 or seconds is None or seconds <= 0:
+        if r["series"] in ("reference", "tolerance") or error is None or error <= 0 or seconds is None or seconds <= 0:
             continue
         curves.setdefault((r["method"], r["series"]), []).append((seconds, error, short_setting(r)))
     for (method, series), points in curves.items():
@@ -194,6 +200,117 @@ def draw_fold_panel(ax, rows, case, colour):
         ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
 
 
+TOLERANCE_MARKERS = ["o", "s", "^", "D"]  # by time step, in file order
+
+
+def tolerance_rows(rows, case):
+    """The case's rows of the tolerance series that have a tolerance."""
+    return [r for r in rows if r["case"] == case and r["series"] == "tolerance" and number(r, "tolerance")]
+
+
+def has_tolerance_series(rows, case):
+    return bool(tolerance_rows(rows, case))
+
+
+def tolerance_settings(rows, case):
+    """(method, dt) -> marker, in file order."""
+    dts, markers = [], {}
+    for r in tolerance_rows(rows, case):
+        if r["dt"] not in dts:
+            dts.append(r["dt"])
+        markers.setdefault((r["method"], r["dt"]), TOLERANCE_MARKERS[dts.index(r["dt"]) % len(TOLERANCE_MARKERS)])
+    return markers
+
+
+def dt_label(dt):
+    return f"dt = {float(dt) * 1e3:g} ms"
+
+
+def draw_tolerance_error_panel(ax, rows, case, colour):
+    """Solver error against tolerance, log-log; the discretisation error of each setting as a thin
+    horizontal line."""
+    markers = tolerance_settings(rows, case)
+    windows = []
+    for r in tolerance_rows(rows, case):
+        if r["window"] not in windows:
+            windows.append(r["window"])
+    curves, levels = {}, {}
+    for r in tolerance_rows(rows, case):
+        key = (r["method"], r["dt"], r["window"])
+        error = number(r, "solver_error")
+        if error is not None and error > 0:
+            curves.setdefault(key, []).append((number(r, "tolerance"), error))
+        level = number(r, "discretization_error")
+        if level is not None and level > 0:
+            levels[key] = level
+    for (method, dt, window), points in curves.items():
+        first = window == windows[0]
+        points.sort()
+        ax.plot([p[0] for p in points], [p[1] for p in points], linestyle="-" if first else ":",
+                marker=markers[(method, dt)], color=colour[method], markersize=5,
+                markerfacecolor=colour[method] if first else "white")
+    for (method, dt, window), level in levels.items():
+        ax.axhline(level, color=colour[method], linestyle="-" if window == windows[0] else ":", linewidth=0.9,
+                   alpha=0.55, zorder=0)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("linear solver tolerance (relative residual) [-]")
+    ax.set_ylabel("solver error vs. the tight run [-]")
+    ax.set_title(f"{case}: solver error against tolerance (thin lines: discretisation error)", fontsize=10)
+    ax.grid(True, which="major", alpha=0.4)
+    ax.grid(True, which="minor", alpha=0.12)
+    handles = [plt.Line2D([], [], color=colour[method], linestyle="", marker=m, label=f"{method} · {dt_label(dt)}")
+               for (method, dt), m in markers.items()]
+    handles += [plt.Line2D([], [], color="0.3", linestyle="-" if w == windows[0] else ":",
+                           markerfacecolor="0.3" if w == windows[0] else "white", marker="o", label=f"window {w}")
+                for w in windows]
+    handles.append(plt.Line2D([], [], color="0.3", linewidth=0.9, alpha=0.55,
+                              label="discretisation error (tight run vs. reference)"))
+    ax.legend(handles=handles, fontsize=6.5, loc="best")
+    if not curves:
+        ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
+
+
+def draw_tolerance_cost_panel(ax, rows, case, colour):
+    """Wall time per run (solid, left axis) and PCG iterations per step (dashed, right axis)
+    against tolerance, one point per run (the first window's rows)."""
+    markers = tolerance_settings(rows, case)
+    first = next((r["window"] for r in tolerance_rows(rows, case)), "")
+    curves = {}
+    for r in tolerance_rows(rows, case):
+        if r["window"] != first:
+            continue
+        seconds, iterations, steps = number(r, "wall_seconds"), number(r, "solver_iterations"), number(r, "steps")
+        if seconds is None or seconds <= 0 or not steps:
+            continue
+        curves.setdefault((r["method"], r["dt"]), []).append((number(r, "tolerance"), seconds, iterations / steps))
+    right = ax.twinx()
+    for (method, dt), points in curves.items():
+        points.sort()
+        x = [p[0] for p in points]
+        ax.plot(x, [p[1] for p in points], linestyle="-", marker=markers[(method, dt)], color=colour[method],
+                markersize=5)
+        right.plot(x, [p[2] for p in points], linestyle="--", marker=markers[(method, dt)], color=colour[method],
+                   markersize=4, markerfacecolor="white")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("linear solver tolerance (relative residual) [-]")
+    ax.set_ylabel("wall time per run [s] (solid)")
+    right.set_ylabel("PCG iterations per step (dashed)")
+    right.set_ylim(bottom=0)
+    ax.set_title(f"{case}: cost against tolerance", fontsize=10)
+    ax.grid(True, which="major", alpha=0.4)
+    handles = [plt.Line2D([], [], color=colour[method], linestyle="", marker=m, label=f"{method} · {dt_label(dt)}")
+               for (method, dt), m in markers.items()]
+    ax.legend(handles=handles, fontsize=6.5, loc="best")
+    if not curves:
+        ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
+
+
+EXTRA_PANELS = {"energy": draw_energy_panel, "folds": draw_fold_panel,
+                "tolerance_error": draw_tolerance_error_panel, "tolerance_cost": draw_tolerance_cost_panel}
+
+
 def main(argv):
     if len(argv) != 3:
         sys.stderr.write("usage: plot_convergence.py RESULTS.csv OUTPUT.png\n")
@@ -208,9 +325,16 @@ def main(argv):
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     colour = {m: colours[i % len(colours)] for i, m in enumerate(methods)}
 
-    # The post-buckling panels: energy and folds for every dynamic case that has them, in pairs.
-    extra = [(kind, case) for case in panels if case != PLATES and has_end_state(rows, case)
-             for kind in ("energy", "folds")]
+    # The post-buckling panels (energy and folds) and the tolerance panels (solver error, cost) for
+    # every dynamic case that has them, in pairs.
+    extra = []
+    for case in panels:
+        if case == PLATES:
+            continue
+        if has_end_state(rows, case):
+            extra += [("energy", case), ("folds", case)]
+        if has_tolerance_series(rows, case):
+            extra += [("tolerance_error", case), ("tolerance_cost", case)]
     columns = 2 if len(panels) + len(extra) > 1 else 1
     first_extra = math.ceil(len(panels) / columns) * columns  # the pairs start on a new row
     grid_rows = max(1, math.ceil((first_extra + len(extra)) / columns)) if extra else max(1, math.ceil(len(panels) / columns))
@@ -219,7 +343,7 @@ def main(argv):
         ax.set_visible(False)
     for ax, (kind, case) in zip(axes.flat[first_extra:], extra):
         ax.set_visible(True)
-        (draw_energy_panel if kind == "energy" else draw_fold_panel)(ax, rows, case, colour)
+        EXTRA_PANELS[kind](ax, rows, case, colour)
 
     shared_legend = {}  # dynamic panels: label -> handle (same styles in every panel)
     for ax, panel in zip(axes.flat, panels):

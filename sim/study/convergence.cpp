@@ -3,6 +3,7 @@
 #include "sim/dynamics/simulator.hpp"
 #include "sim/scene/scene.hpp"
 #include "sim/shell/dof_map.hpp"
+#include "sim/solver/linear_solver.hpp"
 #include "sim/study/report_format.hpp"
 
 #include <Eigen/Geometry>
@@ -115,6 +116,12 @@ std::string sleeve_setting(const SleeveMesh& m, double dt) {
   return std::to_string(m.segments) + "x" + std::to_string(m.rings) + " dt=" + format_shortest(dt);
 }
 
+// The relative-residual tolerance a problem's linear solver works to, or none for a direct solver.
+std::optional<double> solver_tolerance(const Problem& problem) {
+  if (problem.solver.type == LinearSolverType::cholmod) return std::nullopt;
+  return problem.solver.tolerance;
+}
+
 // Each window's times must be positive, increasing and whole numbers of steps of `dt`.
 void check_sample_times(const SleeveStudyCase& c, double dt) {
   for (const ErrorWindow& w : c.windows) {
@@ -181,14 +188,17 @@ class SleeveScene {
                                                      "full \"cylinder\" primitive");
   }
 
-  // The scene with the given mesh, time step and discretisation (its mesh prepared for it).
-  Problem problem(const SleeveMesh& m, double dt, const std::string& discretization) const {
+  // The scene with the given mesh, time step and discretisation (its mesh prepared for it), and
+  // with the linear solver's tolerance (solver.tolerance) replaced if one is given.
+  Problem problem(const SleeveMesh& m, double dt, const std::string& discretization,
+                  std::optional<double> tolerance = std::nullopt) const {
     nlohmann::json j = json_;
     j["method"] = discretization;
     j["mesh"]["segments"] = m.segments;
     j["mesh"]["rings"] = m.rings;
     j["time"]["dt"] = dt;
     j["time"]["end"] = all_sample_times(case_).back();
+    if (tolerance) j["solver"]["tolerance"] = *tolerance;
     return load_scene_text(j.dump(2), case_.scene, LogFn()).problem;
   }
 
@@ -205,6 +215,7 @@ struct Outcome {
   // The post-buckling measures at the end of the run (none if the method did not report them).
   std::optional<double> energy;                          // [J]
   std::optional<double> folds_circumferential, folds_axial;  // medians (count_sleeve_folds)
+  std::optional<double> tolerance;  // the linear solver's relative-residual tolerance (none: direct)
 };
 
 const Method& find_method(const std::vector<Method>& methods, const std::vector<Method>& registered,
@@ -285,6 +296,14 @@ class StudyRunner {
   void run_sleeve(const SleeveStudyCase& c, std::vector<ConvergenceRow>& rows) {
     if (c.windows.empty()) throw std::invalid_argument(c.name + ": no error windows");
     for (double dt : c.dts) check_sample_times(c, dt);
+    if (!c.tolerances.empty()) {
+      for (double dt : c.tolerance_dts) check_sample_times(c, dt);
+      for (double tolerance : c.tolerances)
+        if (!(tolerance > c.tight_tolerance && tolerance < 1))
+          throw std::invalid_argument(c.name + ": tolerance " + format_shortest(tolerance) +
+                                      ": the tolerance series' tolerances must lie between its tight tolerance " +
+                                      format_shortest(c.tight_tolerance) + " and 1");
+    }
     check_sample_times(c, c.mesh_dt);
     check_sample_times(c, c.reference_dt);
     const Method& reference_method = find_method(methods_, registered_, c.reference_method);
@@ -299,15 +318,19 @@ class StudyRunner {
     const std::string reference_text =
         "finest run: " + reference_method.name + " " + sleeve_setting(c.reference_mesh, c.reference_dt);
 
-    auto add = [&](const Method& method, const std::string& series, const SleeveMesh& m, double dt) {
-      const Outcome& o = outcome(c, scene, times, method, m, dt);
+    // One run's rows. A tolerance-series run passes its tolerance and its solver reference (the
+    // tight-tolerance run of the same method, mesh and time step).
+    auto add = [&](const Method& method, const std::string& series, const SleeveMesh& m, double dt,
+                   std::optional<double> tolerance = std::nullopt, const Outcome* solver_reference = nullptr) {
+      const Outcome& o = outcome(c, scene, times, method, m, dt, tolerance);
       for (const ErrorWindow& window : c.windows) {
         ConvergenceRow row;
         row.case_name = c.name;
         row.method = method.name;
         row.series = series;
         row.window = window.name;
-        row.setting = sleeve_setting(m, dt);
+        row.setting = sleeve_setting(m, dt) + (tolerance ? " tol=" + format_shortest(*tolerance) : "");
+        row.tolerance = o.tolerance;
         row.h = o.h;
         row.dt = dt;
         row.quantity = "RMS surface displacement [m] at " + std::to_string(c.grid_theta) + "x" +
@@ -329,6 +352,7 @@ class StudyRunner {
             fill_post_buckling(row, o, reference);
           }
         }
+        if (solver_reference) fill_solver_error(row, o, *solver_reference, reference, times, window);
         report(row);
         rows.push_back(row);
       }
@@ -343,11 +367,20 @@ class StudyRunner {
         continue;
       }
       for (const SleeveMesh& m : c.meshes) add(method, "mesh", m, c.mesh_dt);
-      const bool dt_series = c.dt_series_methods.empty() ||
-                             std::find(c.dt_series_methods.begin(), c.dt_series_methods.end(), method.name) !=
-                                 c.dt_series_methods.end();
+      const bool dt_series = listed(c.dt_series_methods, method.name);
       if (dt_series)
         for (double dt : c.dts) add(method, "dt", c.dt_mesh, dt);
+    }
+    // The tolerance series, after the others (its runs at the scene's own tolerance may be theirs).
+    for (const Method& method : methods_) {
+      if (!method.run_dynamic || c.tolerances.empty() || !listed(c.tolerance_series_methods, method.name) ||
+          !unsupported(method, scene.problem(c.reference_mesh, c.reference_dt, method.discretization)).empty())
+        continue;
+      for (double dt : c.tolerance_dts) {
+        const Outcome& tight = outcome(c, scene, times, method, c.tolerance_mesh, dt, c.tight_tolerance);
+        for (double tolerance : c.tolerances) add(method, "tolerance", c.tolerance_mesh, dt, tolerance, &tight);
+        add(method, "tolerance", c.tolerance_mesh, dt, c.tight_tolerance, &tight);
+      }
     }
   }
 
@@ -399,6 +432,32 @@ class StudyRunner {
       row.fold_difference_axial = *o.folds_axial - *reference.folds_axial;
   }
 
+  // The tolerance-series columns of a row of run `o`: against its solver reference `tight` and
+  // `tight` against the study's reference, in the row's window.
+  static void fill_solver_error(ConvergenceRow& row, const Outcome& o, const Outcome& tight, const Outcome& reference,
+                                const std::vector<double>& times, const ErrorWindow& window) {
+    if (!tight.failure.empty()) {
+      if (row.note.empty()) row.note = "failed: the solver reference (tight tolerance) failed: " + tight.failure;
+      return;
+    }
+    if (&o == &tight && row.note.empty()) row.note = "the solver reference of this setting (solver error 0 by definition)";
+    const std::vector<Eigen::MatrixX3d> u_tight = window_samples(tight.run.displacements, times, window);
+    if (reference.failure.empty())
+      row.discretization_error =
+          relative_rms_difference(u_tight, window_samples(reference.run.displacements, times, window));
+    if (tight.energy && reference.energy)
+      row.discretization_energy_error = std::abs(*tight.energy - *reference.energy) / std::abs(*reference.energy);
+    row.solver_reference_folds_circumferential = tight.folds_circumferential;
+    row.solver_reference_folds_axial = tight.folds_axial;
+    if (!o.failure.empty()) return;
+    row.solver_error = relative_rms_difference(window_samples(o.run.displacements, times, window), u_tight);
+    if (o.energy && tight.energy) row.solver_energy_error = std::abs(*o.energy - *tight.energy) / std::abs(*tight.energy);
+  }
+
+  static bool listed(const std::vector<std::string>& names, const std::string& name) {
+    return names.empty() || std::find(names.begin(), names.end(), name) != names.end();
+  }
+
   static void mark_failed(ConvergenceRow& row, const std::string& why) {
     row.error = std::numeric_limits<double>::quiet_NaN();
     row.note = "failed: " + why;
@@ -408,17 +467,24 @@ class StudyRunner {
     if (!log_) return;
     log_("case " + row.case_name + " method " + row.method + " setting " + row.setting +
          (row.window.empty() || row.window == "static" ? "" : " window " + row.window) + " error " +
-         format_significant(row.error, 4) + " (" + format_fixed(row.wall_seconds, 2) + " s)" +
+         format_significant(row.error, 4) +
+         (row.solver_error ? " solver error " + format_significant(*row.solver_error, 4) : std::string()) + " (" +
+         format_fixed(row.wall_seconds, 2) + " s)" +
          (row.note.empty() ? "" : " [" + row.note + "]"));
   }
 
-  // The run of `method` on mesh m at time step dt, computed once per case.
+  // The run of `method` on mesh m at time step dt (with the linear solver's tolerance replaced if
+  // one is given), computed once per case: runs with the same effective settings are one run.
   const Outcome& outcome(const SleeveStudyCase& c, const SleeveScene& scene, const std::vector<double>& times,
-                         const Method& method, const SleeveMesh& m, double dt) {
-    const std::string key = method.name + " " + sleeve_setting(m, dt);
+                         const Method& method, const SleeveMesh& m, double dt,
+                         std::optional<double> tolerance = std::nullopt) {
+    const Problem problem = scene.problem(m, dt, method.discretization, tolerance);
+    const std::optional<double> effective = solver_tolerance(problem);
+    const std::string key = method.name + " " + sleeve_setting(m, dt) + " tol=" +
+                            (effective ? format_shortest(*effective) : std::string("direct"));
     if (auto it = cache_.find(key); it != cache_.end()) return it->second;
     Outcome o;
-    const Problem problem = scene.problem(m, dt, method.discretization);
+    o.tolerance = effective;
     o.h = mesh_size(problem.mesh);
     const std::vector<SurfaceSample> points =
         locate_points(problem.mesh.triangles, cylinder_chart(problem.mesh.vertices),
@@ -451,7 +517,7 @@ class StudyRunner {
 void fill_orders(std::vector<ConvergenceRow>& rows) {
   std::map<std::string, const ConvergenceRow*> previous;
   for (ConvergenceRow& row : rows) {
-    if (row.series == "reference") continue;
+    if (row.series != "mesh" && row.series != "dt") continue;
     const std::string key = row.case_name + "\n" + row.method + "\n" + row.series + "\n" + row.window;
     if (auto it = previous.find(key); it != previous.end()) {
       const ConvergenceRow& p = *it->second;
@@ -547,6 +613,14 @@ ConvergencePlan full_convergence_plan(const std::filesystem::path& scenes_dir) {
     c.dt_series_methods = {"loop_one_point", "loop_three_point"};
     c.reference_mesh = meshes.back();
     c.reference_dt = 5e-4;
+    // The tolerance series on the shipped mesh, at the scenes' own time step (1 ms, what users run)
+    // and at the reference's: the candidates 1e-2 … 1e-8 (today's default), the spread runs
+    // 1e-9 … 1e-11 and the tight run (ToleranceRule, docs/convergence.md "Solver tolerance").
+    c.tolerances = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11};
+    c.tight_tolerance = 1e-12;
+    c.tolerance_mesh = {26, 19};
+    c.tolerance_dts = {1e-3, 5e-4};
+    c.tolerance_series_methods = {"loop_one_point", "loop_three_point"};
     plan.sleeves.push_back(c);
   }
   return plan;
@@ -568,6 +642,13 @@ ConvergencePlan quick_convergence_plan(const std::filesystem::path& scenes_dir) 
   c.dt_series_methods = {"loop_one_point", "loop_three_point"};  // as the full plan
   c.reference_mesh = {16, 11};
   c.reference_dt = 1e-3;
+  // Candidates 1e-2, 1e-3, 1e-5, 1e-8 (the last the scene's own: its run is the mesh series'), one
+  // spread run and the tight run.
+  c.tolerances = {1e-2, 1e-3, 1e-5, 1e-8, 1e-10};
+  c.tight_tolerance = 1e-12;
+  c.tolerance_mesh = {12, 9};
+  c.tolerance_dts = {2e-3};
+  c.tolerance_series_methods = {"loop_one_point", "loop_three_point"};
   plan.sleeves.push_back(c);
   return plan;
 }
@@ -589,7 +670,8 @@ const std::vector<std::string>& results_csv_columns() {
       "order",    "quantity", "value",         "reference_value",     "reference_precision",   "reference",
       "note",     "elastic_energy", "reference_elastic_energy", "energy_error", "folds_circumferential", "folds_axial",
       "reference_folds_circumferential", "reference_folds_axial", "fold_difference_circumferential",
-      "fold_difference_axial"};
+      "fold_difference_axial", "tolerance", "solver_error", "discretization_error", "solver_energy_error",
+      "discretization_energy_error", "solver_reference_folds_circumferential", "solver_reference_folds_axial"};
   return columns;
 }
 
@@ -617,26 +699,186 @@ void write_results_csv(std::ostream& out, const std::vector<ConvergenceRow>& row
         << optional_number(r.folds_circumferential) << ',' << optional_number(r.folds_axial) << ','
         << optional_number(r.reference_folds_circumferential) << ',' << optional_number(r.reference_folds_axial) << ','
         << optional_number(r.fold_difference_circumferential) << ',' << optional_number(r.fold_difference_axial)
-        << '\n';
+        << ',' << optional_number(r.tolerance) << ',' << optional_number(r.solver_error) << ','
+        << optional_number(r.discretization_error) << ',' << optional_number(r.solver_energy_error) << ','
+        << optional_number(r.discretization_energy_error) << ','
+        << optional_number(r.solver_reference_folds_circumferential) << ','
+        << optional_number(r.solver_reference_folds_axial) << '\n';
 }
 
 void write_results_markdown(std::ostream& out, const std::vector<ConvergenceRow>& rows) {
   out << "| case | method | series | window | setting | vertices | dofs | dt [s] | wall [s] | solver iterations | "
-         "error | order | energy error | folds circ. / axial (ref.) |\n"
-         "|---|---|---|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
+         "error | order | energy error | folds circ. / axial (ref.) | tolerance | solver error | "
+         "discretisation error |\n"
+         "|---|---|---|---|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
   auto folds = [](const ConvergenceRow& r) -> std::string {
     if (!r.folds_circumferential && !r.folds_axial) return "";
     auto count = [](const std::optional<double>& x) { return x ? format_shortest(*x) : std::string("–"); };
     return count(r.folds_circumferential) + " / " + count(r.folds_axial) + " (" +
            count(r.reference_folds_circumferential) + " / " + count(r.reference_folds_axial) + ")";
   };
+  auto significant = [](const std::optional<double>& x) { return x ? format_significant(*x, 3) : std::string(); };
   for (const ConvergenceRow& r : rows)
     out << "| " << markdown_cell(r.case_name) << " | " << markdown_cell(r.method) << " | " << r.series << " | "
         << markdown_cell(r.window) << " | " << markdown_cell(r.setting) << " | " << r.vertices << " | " << r.dofs << " | "
         << (r.dt > 0 ? format_shortest(r.dt) : "–") << " | " << format_fixed(r.wall_seconds, 3) << " | "
         << r.solver_iterations << " | " << format_significant(r.error, 3) << " | "
         << (r.order ? format_fixed(*r.order, 2) : "") << " | "
-        << (r.energy_error ? format_significant(*r.energy_error, 3) : "") << " | " << folds(r) << " |\n";
+        << (r.energy_error ? format_significant(*r.energy_error, 3) : "") << " | " << folds(r) << " | "
+        << (r.tolerance ? format_shortest(*r.tolerance) : "") << " | " << significant(r.solver_error) << " | "
+        << significant(r.discretization_error) << " |\n";
+}
+
+}  // namespace clothsim
+
+namespace clothsim {
+
+ToleranceSummary summarize_tolerance_series(const std::vector<ConvergenceRow>& rows, const ToleranceRule& rule) {
+  ToleranceSummary summary;
+  summary.rule = rule;
+  // The tolerance rows of each setting, in the order of the rows.
+  std::vector<std::vector<const ConvergenceRow*>> groups;
+  std::map<std::string, size_t> group_of;
+  for (const ConvergenceRow& r : rows) {
+    if (r.series != "tolerance" || !r.tolerance) continue;
+    const std::string key = r.case_name + "\n" + r.method + "\n" + format_shortest(r.dt);
+    const auto [it, added] = group_of.emplace(key, groups.size());
+    if (added) groups.emplace_back();
+    groups[it->second].push_back(&r);
+  }
+  bool complete = !groups.empty(), any_resolved = false;
+  double recommended = std::numeric_limits<double>::infinity();
+  for (const std::vector<const ConvergenceRow*>& group : groups) {
+    ToleranceSettingCheck check;
+    check.case_name = group.front()->case_name;
+    check.method = group.front()->method;
+    check.dt = group.front()->dt;
+    std::vector<std::string> windows;
+    std::set<double> tolerances;
+    for (const ConvergenceRow* r : group) {
+      tolerances.insert(*r->tolerance);
+      if (std::find(windows.begin(), windows.end(), r->window) == windows.end()) windows.push_back(r->window);
+    }
+    check.tight_tolerance = *tolerances.begin();
+    for (auto it = tolerances.rbegin(); it != tolerances.rend(); ++it)
+      if (*it >= rule.baseline && *it != check.tight_tolerance) check.candidates.push_back(*it);
+    auto is_baseline = [&](double t) { return t <= rule.baseline || t == check.tight_tolerance; };
+    auto row_at = [&](double t, const std::string& window) -> const ConvergenceRow* {
+      for (const ConvergenceRow* r : group)
+        if (*r->tolerance == t && r->window == window) return r;
+      return nullptr;
+    };
+    for (const std::string& window : windows) {
+      ToleranceWindowCheck w;
+      w.window = window;
+      const ConvergenceRow* tight = row_at(check.tight_tolerance, window);
+      w.discretization_error = tight && tight->discretization_error ? *tight->discretization_error
+                                                                    : std::numeric_limits<double>::quiet_NaN();
+      for (double t : tolerances) {
+        if (!is_baseline(t) || t == check.tight_tolerance) continue;
+        const ConvergenceRow* r = row_at(t, window);
+        const double e = r && r->solver_error ? *r->solver_error : std::numeric_limits<double>::infinity();
+        w.baseline_solver_error = std::max(w.baseline_solver_error, e);
+        w.amplification = std::max(w.amplification, e / t);
+      }
+      const double limit = rule.ratio * w.discretization_error;  // NaN: no candidate passes
+      w.resolved = w.amplification <= rule.max_amplification;
+      // Tight to loose: the loosest candidate before the first that fails.
+      for (auto it = check.candidates.rbegin(); it != check.candidates.rend(); ++it) {
+        const ConvergenceRow* r = row_at(*it, window);
+        if (!r || !r->solver_error || !(*r->solver_error <= limit)) break;
+        w.loosest = *it;
+      }
+      if (w.resolved) {
+        any_resolved = true;
+        if (w.loosest) recommended = std::min(recommended, *w.loosest);
+        else complete = false;
+      }
+      check.windows.push_back(w);
+    }
+    // The end state (the same in every window's rows: take the first window's).
+    auto widen = [](double& lo, double& hi, const std::optional<double>& x) {
+      if (!x) return;
+      lo = std::isnan(lo) ? *x : std::min(lo, *x);
+      hi = std::isnan(hi) ? *x : std::max(hi, *x);
+    };
+    for (double t : tolerances) {
+      if (!is_baseline(t)) continue;
+      const ConvergenceRow* r = row_at(t, windows.front());
+      if (!r) continue;
+      if (t != check.tight_tolerance && r->solver_energy_error)
+        check.energy_spread = std::isnan(check.energy_spread) ? *r->solver_energy_error
+                                                              : std::max(check.energy_spread, *r->solver_energy_error);
+      widen(check.folds_circumferential_min, check.folds_circumferential_max, r->folds_circumferential);
+      widen(check.folds_axial_min, check.folds_axial_max, r->folds_axial);
+    }
+    auto inside = [](const std::optional<double>& x, double lo, double hi) {
+      return std::isnan(lo) || (x && *x >= lo && *x <= hi);
+    };
+    for (double t : check.candidates) {
+      if (t <= rule.baseline) continue;
+      const ConvergenceRow* r = row_at(t, windows.front());
+      // The energy may differ from the tight run's by the spread, or (an end state before buckling,
+      // where the spread is round-off) by ratio × the setting's discretisation error of the energy.
+      double energy_bound = check.energy_spread;
+      if (r && r->discretization_energy_error)
+        energy_bound = std::max(energy_bound, rule.ratio * *r->discretization_energy_error);
+      const bool energy_ok =
+          std::isnan(energy_bound) || (r && r->solver_energy_error && *r->solver_energy_error <= energy_bound);
+      if (!r || !std::isfinite(r->error) || !energy_ok ||
+          !inside(r->folds_circumferential, check.folds_circumferential_min, check.folds_circumferential_max) ||
+          !inside(r->folds_axial, check.folds_axial_min, check.folds_axial_max))
+        check.outside_spread.push_back(t);
+    }
+    summary.settings.push_back(std::move(check));
+  }
+  if (complete && any_resolved) summary.recommended = recommended;
+  return summary;
+}
+
+void write_tolerance_summary_markdown(std::ostream& out, const ToleranceSummary& summary) {
+  if (summary.settings.empty()) return;
+  const ToleranceRule& rule = summary.rule;
+  auto range = [](double lo, double hi) {
+    if (std::isnan(lo)) return std::string("–");
+    return lo == hi ? format_shortest(lo) : format_shortest(lo) + "–" + format_shortest(hi);
+  };
+  auto list = [](const std::vector<double>& xs) {
+    std::string s;
+    for (double x : xs) s += (s.empty() ? "" : ", ") + format_shortest(x);
+    return s.empty() ? std::string("none") : s;
+  };
+  out << "\n## Solver tolerance\n\n"
+         "Rule (docs/convergence.md, \"Solver tolerance\"): the loosest tolerance whose solver error (against the "
+         "setting's tight run), and that of every tighter candidate, is at most "
+      << format_shortest(rule.ratio)
+      << " × the discretisation error (the tight run against the reference), in every resolved window. Baseline "
+         "runs: tolerances up to "
+      << format_shortest(rule.baseline) << " and the tight run; a window is resolved when none of them has a solver "
+      << "error above " << format_shortest(rule.max_amplification)
+      << " × its tolerance (after buckling, perturbations grow by orders of magnitude).\n\n"
+         "| case | method | dt [s] | window | discretisation error | baseline runs' solver error | "
+         "largest solver error / tolerance | resolved | loosest passing |\n|---|---|--:|---|--:|--:|--:|---|--:|\n";
+  for (const ToleranceSettingCheck& s : summary.settings)
+    for (const ToleranceWindowCheck& w : s.windows)
+      out << "| " << markdown_cell(s.case_name) << " | " << markdown_cell(s.method) << " | " << format_shortest(s.dt)
+          << " | " << markdown_cell(w.window) << " | " << format_significant(w.discretization_error, 3) << " | "
+          << format_significant(w.baseline_solver_error, 3) << " | " << format_significant(w.amplification, 2) << " | "
+          << (w.resolved ? "yes" : "no") << " | "
+          << (w.loosest ? format_shortest(*w.loosest) : std::string("none")) << " |\n";
+  out << "\nEnd state (post-buckling measures) of the candidates looser than the baseline against the spread of "
+         "the baseline runs:\n\n"
+         "| case | method | dt [s] | energy spread | folds circ. | folds axial | candidates outside the spread |\n"
+         "|---|---|--:|--:|--:|--:|---|\n";
+  for (const ToleranceSettingCheck& s : summary.settings)
+    out << "| " << markdown_cell(s.case_name) << " | " << markdown_cell(s.method) << " | " << format_shortest(s.dt)
+        << " | " << format_significant(s.energy_spread, 3) << " | "
+        << range(s.folds_circumferential_min, s.folds_circumferential_max) << " | "
+        << range(s.folds_axial_min, s.folds_axial_max) << " | " << list(s.outside_spread) << " |\n";
+  out << "\nRecommended tolerance by the rule: "
+      << (summary.recommended ? format_shortest(*summary.recommended)
+                              : std::string("none (no resolved window, or one in which no candidate passes)"))
+      << "\n";
 }
 
 }  // namespace clothsim

@@ -144,6 +144,19 @@ struct SleeveStudyCase {
   std::vector<double> dts;         // [s], large to small
   // Methods that also run the time-step series (the others run the mesh series only); empty: all.
   std::vector<std::string> dt_series_methods;
+  // Tolerance series (the linear solver's relative-residual tolerance, the scene's
+  // solver.tolerance): the methods in tolerance_series_methods on tolerance_mesh at each time step
+  // of tolerance_dts, once with every tolerance of `tolerances` and once with tight_tolerance,
+  // the solver reference of that setting (its solver error is 0 by definition). Each run's error
+  // is reported against the study's reference (total error), against the tight run of its setting
+  // (solver error), and the tight run's against the reference (discretisation error). Empty
+  // `tolerances`: no tolerance series.
+  std::vector<double> tolerances;  // loose to tight, each > tight_tolerance
+  double tight_tolerance = 1e-12;
+  SleeveMesh tolerance_mesh;
+  std::vector<double> tolerance_dts;  // [s]
+  // Methods that run the tolerance series; empty: all.
+  std::vector<std::string> tolerance_series_methods;
   SleeveMesh reference_mesh;       // the reference run: this mesh, reference_dt, reference_method
   double reference_dt = 5e-4;      // [s]
   std::string reference_method = "loop_three_point";
@@ -166,10 +179,12 @@ ConvergencePlan quick_convergence_plan(const std::filesystem::path& scenes_dir);
 struct ConvergenceRow {
   std::string case_name;  // "plate_ss_uniform", "sleeve_gravity", ...
   std::string method;     // Method::name
-  std::string series;     // "mesh" (refining the mesh), "dt" (refining the time step) or
+  std::string series;     // "mesh" (refining the mesh), "dt" (refining the time step),
+                          // "tolerance" (loosening the linear solver's tolerance) or
                           // "reference" (the run the sleeve's errors are measured against)
   std::string window;     // sleeves: the ErrorWindow's name; plates: "static"
-  std::string setting;    // "16x16" (plate cells) or "26x19 dt=0.001" (sleeve segments x rings)
+  std::string setting;    // "16x16" (plate cells), "26x19 dt=0.001" (sleeve segments x rings,
+                          // time step) or "26x19 dt=0.001 tol=1e-05" (tolerance series)
   int vertices = 0;
   int dofs = 0;
   double h = 0.0;          // [m] mesh size sqrt(2 · area / #triangles) of the rest control mesh
@@ -198,6 +213,19 @@ struct ConvergenceRow {
   std::optional<double> reference_folds_axial;
   std::optional<double> fold_difference_circumferential;  // folds − reference folds
   std::optional<double> fold_difference_axial;
+  // The linear solver's relative-residual tolerance of the run (dynamic runs solved by PCG; empty
+  // for static solves and direct solvers).
+  std::optional<double> tolerance;
+  // Tolerance series only (empty in the other series): the run against the tight-tolerance run of
+  // its method, mesh and time step (the solver reference) — the window's norm (relative to the
+  // solver reference's RMS |u|) and its end energy, and that run's fold counts — and the solver
+  // reference against the study's reference (the discretisation error of the setting).
+  std::optional<double> solver_error;
+  std::optional<double> discretization_error;
+  std::optional<double> solver_energy_error;          // |E − E_tight| / |E_tight|
+  std::optional<double> discretization_energy_error;  // |E_tight − E_ref| / |E_ref|
+  std::optional<double> solver_reference_folds_circumferential;
+  std::optional<double> solver_reference_folds_axial;
 };
 
 // Progress lines ("case ... method ... setting ... error ... (x s)") go to `log` (may be empty).
@@ -212,7 +240,9 @@ std::vector<ConvergenceRow> run_convergence(const ConvergencePlan& plan, const s
 // wall_seconds, solver_iterations, error, order, quantity, value, reference_value,
 // reference_precision, reference, note, elastic_energy, reference_elastic_energy, energy_error,
 // folds_circumferential, folds_axial, reference_folds_circumferential, reference_folds_axial,
-// fold_difference_circumferential, fold_difference_axial.
+// fold_difference_circumferential, fold_difference_axial, tolerance, solver_error,
+// discretization_error, solver_energy_error, discretization_energy_error,
+// solver_reference_folds_circumferential, solver_reference_folds_axial.
 const std::vector<std::string>& results_csv_columns();
 
 // Writes the header line and one line per row (RFC 4180 quoting where needed; numbers in the
@@ -222,7 +252,83 @@ const std::vector<std::string>& results_csv_columns();
 void write_results_csv(std::ostream& out, const std::vector<ConvergenceRow>& rows);
 
 // A Markdown table of the rows (case, method, series, window, setting, vertices, dofs, dt, wall time,
-// iterations, error, order).
+// iterations, error, order, energy error, folds, tolerance, solver error, discretisation error).
 void write_results_markdown(std::ostream& out, const std::vector<ConvergenceRow>& rows);
+
+// The rule that chooses the linear solver's tolerance from the tolerance series
+// (docs/convergence.md, "Solver tolerance"). Of a setting's (case, method, time step) tolerance
+// runs, those at tolerances >= baseline other than the tight run are the *candidates* (loose to
+// tight); those at tolerances <= baseline, the tight run included, are the *baseline runs*:
+// today's default and tighter, they differ from the tight run only by perturbations far below
+// any discretisation error, which after a buckling bifurcation are amplified and decide the end
+// state — their differences are the run-to-run spread of that state.
+//  - A window is *resolved* when no baseline run (other than the tight one) has a solver error
+//    above max_amplification × its tolerance. Before a bifurcation the solver error is at most a
+//    few times the tolerance; after one, perturbations grow by many orders of magnitude and the
+//    window's norm measures that growth, not the solver's accuracy. Unresolved windows do not
+//    enter the rule.
+//  - In a resolved window, the loosest candidate whose solver error, and that of every tighter
+//    candidate, is at most ratio × the discretisation error (the tight run against the reference).
+//  - The end state (elastic energy and fold counts at the end of the run) of every candidate looser
+//    than the baseline is compared with the range the baseline runs span (the energy also with
+//    ratio × its discretisation error).
+struct ToleranceRule {
+  double ratio = 0.1;               // solver error at most ratio × the discretisation error
+  double baseline = 1e-8;           // [-] today's default tolerance
+  double max_amplification = 1e3;   // largest solver error / tolerance of a resolved window's baseline runs
+};
+
+// One error window of one setting.
+struct ToleranceWindowCheck {
+  std::string window;
+  double discretization_error = 0.0;  // the tight run against the study's reference
+  // Of the baseline runs other than the tight one: the largest solver error, and the largest
+  // solver error / tolerance (0 if there are none).
+  double baseline_solver_error = 0.0;
+  double amplification = 0.0;
+  bool resolved = true;  // amplification <= max_amplification
+  // The loosest candidate whose solver error, and that of every tighter candidate, is at most
+  // ratio × discretization_error; none if the tightest candidate already fails.
+  std::optional<double> loosest;
+};
+
+// One setting of the tolerance series: its windows, and its end state against the spread.
+struct ToleranceSettingCheck {
+  std::string case_name;
+  std::string method;
+  double dt = 0.0;                 // [s]
+  double tight_tolerance = 0.0;
+  std::vector<double> candidates;  // loose to tight
+  std::vector<ToleranceWindowCheck> windows;
+  // The end state's spread over the baseline runs: the largest relative energy difference from the
+  // tight run (|E − E_tight| / |E_tight|), and the range of fold counts (the tight run included);
+  // NaN when the runs report none.
+  double energy_spread = std::numeric_limits<double>::quiet_NaN();
+  double folds_circumferential_min = std::numeric_limits<double>::quiet_NaN();
+  double folds_circumferential_max = std::numeric_limits<double>::quiet_NaN();
+  double folds_axial_min = std::numeric_limits<double>::quiet_NaN();
+  double folds_axial_max = std::numeric_limits<double>::quiet_NaN();
+  // Candidates looser than the baseline whose fold counts lie outside that range, or whose energy
+  // differs from the tight run's by more than both energy_spread and ratio × the setting's
+  // discretisation error of the energy (|E_tight − E_ref| / |E_ref|; the bound for an end state
+  // before buckling, where the spread is round-off), or that failed.
+  std::vector<double> outside_spread;
+};
+
+struct ToleranceSummary {
+  ToleranceRule rule;
+  std::vector<ToleranceSettingCheck> settings;  // in the order of the rows
+  // The recommendation: the tightest of the resolved windows' loosest candidates over every
+  // setting; none when there is no tolerance series, no resolved window, or a resolved window in
+  // which no candidate passes.
+  std::optional<double> recommended;
+};
+
+// Applies `rule` to the rows of series "tolerance" (grouped by case, method and time step).
+ToleranceSummary summarize_tolerance_series(const std::vector<ConvergenceRow>& rows, const ToleranceRule& rule = {});
+
+// The summary as Markdown: one table row per setting and window, the end-state check and the
+// recommendation (nothing when there is no tolerance series).
+void write_tolerance_summary_markdown(std::ostream& out, const ToleranceSummary& summary);
 
 }  // namespace clothsim

@@ -28,7 +28,9 @@ const char* const kHeader =
     "case,method,series,window,setting,vertices,dofs,h,dt,steps,wall_seconds,solver_iterations,error,order,quantity,"
     "value,reference_value,reference_precision,reference,note,elastic_energy,reference_elastic_energy,energy_error,"
     "folds_circumferential,folds_axial,reference_folds_circumferential,reference_folds_axial,"
-    "fold_difference_circumferential,fold_difference_axial";
+    "fold_difference_circumferential,fold_difference_axial,tolerance,solver_error,discretization_error,"
+    "solver_energy_error,discretization_energy_error,solver_reference_folds_circumferential,"
+    "solver_reference_folds_axial";
 
 // Runs a shell command; returns its exit status (-1 if it did not exit normally).
 int run_shell(const std::string& command) {
@@ -92,8 +94,11 @@ TEST_F(StudyConvergenceCli, QuickWithoutPlotWritesTheCsv) {
   const std::string csv = read_file_bytes(report() / "results.csv");
   EXPECT_EQ(first_line(csv), kHeader);
   // Quick plan: 1 plate case × 3 static methods (mass_spring is dynamic only) × 3 grids, and 1 sleeve:
-  // reference + 2 Loop rules × (2 meshes + 3 steps) + 2 baselines × 2 meshes (mesh series only).
-  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 9 + 1 + 10 + 4);
+  // reference + 2 Loop rules × (2 meshes + 3 steps) + 2 baselines × 2 meshes (mesh series only) +
+  // 2 Loop rules × 6 tolerances (tolerance series).
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 9 + 1 + 10 + 4 + 12);
+  for (const std::string prefix : {"sleeve_twist,loop_one_point,tolerance,", "sleeve_twist,loop_three_point,tolerance,"})
+    EXPECT_EQ(errors_of(csv, prefix).size(), 6u) << prefix;
   // The baselines' rows have finite errors.
   for (const std::string prefix : {"plate_ss_uniform,linear_fe,mesh,", "sleeve_twist,linear_fe,mesh,",
                                    "sleeve_twist,mass_spring,mesh,"}) {
@@ -105,7 +110,9 @@ TEST_F(StudyConvergenceCli, QuickWithoutPlotWritesTheCsv) {
       EXPECT_TRUE(end != e.c_str() && *end == '\0' && std::isfinite(value) && value > 0) << prefix << " error " << e;
     }
   }
-  EXPECT_TRUE(fs::exists(report() / "results.md"));
+  const std::string md = read_file_bytes(report() / "results.md");
+  EXPECT_NE(md.find("\n## Solver tolerance\n"), std::string::npos) << md;
+  EXPECT_NE(md.find("\nRecommended tolerance by the rule: "), std::string::npos) << md;
   EXPECT_FALSE(fs::exists(report() / "error_vs_time.png"));
   expect_only_the_report_in_out();
 }

@@ -183,11 +183,12 @@ TEST(ConvergenceBaselines, PostBucklingColumnsOfSyntheticRunsWithKnownFolds) {
   EXPECT_EQ(*bellows.fold_difference_axial, 4.0);
   EXPECT_NEAR(*bellows.energy_error, 0.75, 1e-15);
 
-  // The CSV carries them as the last nine fields.
+  // The CSV carries them as the nine fields after `note`, then the run's solver tolerance (the
+  // scene's 1e-8) and the tolerance series' columns (empty: not a tolerance-series row).
   std::ostringstream csv;
   write_results_csv(csv, {five});
   const std::string line = csv.str().substr(csv.str().find('\n') + 1);
-  EXPECT_NE(line.find(",2.5,2,0.25,5,0,8,0,-3,0\n"), std::string::npos) << line;
+  EXPECT_NE(line.find(",2.5,2,0.25,5,0,8,0,-3,0,1e-08,,,,,,\n"), std::string::npos) << line;
 }
 
 // The end state of a sleeve run computed here without the study: the scene with the given mesh
@@ -223,8 +224,9 @@ TEST(ConvergenceBaselines, QuickSleeveWithBaselinesAgainstAnIndependentReference
   ConvergencePlan plan = quick_convergence_plan(CLOTHSIM_SOURCE_DIR "/scenes");
   plan.plates.clear();
   const std::vector<ConvergenceRow> rows = run_convergence(plan, convergence_methods(), {});
-  // reference + 2 Loop rules × (2 meshes + 3 steps) + 2 baselines × 2 meshes
-  ASSERT_EQ(rows.size(), 1u + 10u + 4u);
+  // reference + 2 Loop rules × (2 meshes + 3 steps) + 2 baselines × 2 meshes + 2 Loop rules × 6
+  // tolerances (the baselines do not run the tolerance series)
+  ASSERT_EQ(rows.size(), 1u + 10u + 4u + 12u);
   const ConvergenceRow& ref = rows[0];
   ASSERT_EQ(ref.series, "reference");
   ASSERT_TRUE(ref.energy_error && ref.fold_difference_circumferential && ref.fold_difference_axial);

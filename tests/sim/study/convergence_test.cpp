@@ -8,6 +8,7 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/shell/ghost_layer.hpp"
 #include "sim/study/plates.hpp"
+#include "sim/study/report_format.hpp"
 #include "sim/study/surface_sampling.hpp"
 
 #include <gtest/gtest.h>
@@ -16,7 +17,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <map>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -172,6 +176,7 @@ TEST(ConvergenceStudy, SleeveSeriesAgainstTheFinestRun) {
   plan.plates.clear();
   ASSERT_EQ(plan.sleeves.size(), 1u);
   plan.sleeves[0].windows = {{"early", {0.01, 0.02}}, {"first", {0.01}}};
+  plan.sleeves[0].tolerances.clear();  // the tolerance series: ToleranceSeriesOnTheQuickPlan
   const std::vector<Method> methods = {convergence_methods()[0]};  // the reference method joins anyway
   const std::vector<ConvergenceRow> all = run_convergence(plan, methods, {});
   ASSERT_EQ(all.size(), 2 * (1u + 2u + 3u));
@@ -205,6 +210,179 @@ TEST(ConvergenceStudy, SleeveSeriesAgainstTheFinestRun) {
   EXPECT_EQ(rows[5].setting, rows[2].setting);
   EXPECT_EQ(rows[5].error, rows[2].error);
   EXPECT_EQ(rows[5].wall_seconds, rows[2].wall_seconds);
+}
+
+// The quick plan's tolerance series (12 × 9 at 2 ms, both Loop rules, tolerances 1e-2 … 1e-10 and
+// the tight run at 1e-12): every run reports the tolerance it was solved to; the tight run's solver
+// error is 0 and looser tolerances give larger solver errors and fewer iterations; every row of a
+// setting carries the tight run's error as its discretisation error, and total, discretisation and
+// solver error obey the triangle inequality; the run at the scene's own tolerance (1e-8) is the
+// mesh series' 12 × 9 run.
+TEST(ConvergenceStudy, ToleranceSeriesOnTheQuickPlan) {
+  ConvergencePlan plan = quick_convergence_plan(CLOTHSIM_SOURCE_DIR "/scenes");
+  plan.plates.clear();
+  ASSERT_EQ(plan.sleeves.size(), 1u);
+  const SleeveStudyCase& c = plan.sleeves[0];
+  ASSERT_EQ(c.tolerances, (std::vector<double>{1e-2, 1e-3, 1e-5, 1e-8, 1e-10}));
+  ASSERT_EQ(c.tight_tolerance, 1e-12);
+  const std::vector<Method> loop = {convergence_methods()[0], convergence_methods()[1]};
+  const std::vector<ConvergenceRow> rows = run_convergence(plan, loop, {});
+  for (const Method& method : loop) {
+    SCOPED_TRACE(method.name);
+    std::map<double, const ConvergenceRow*> at;  // the tolerance rows by tolerance
+    const ConvergenceRow* mesh_12x9 = nullptr;
+    for (const ConvergenceRow& r : rows) {
+      if (r.series == "tolerance") {
+        if (r.method != method.name) continue;
+        ASSERT_TRUE(r.tolerance.has_value());
+        EXPECT_TRUE(at.emplace(*r.tolerance, &r).second) << "two rows at tolerance " << *r.tolerance;
+        EXPECT_EQ(r.setting, "12x9 dt=0.002 tol=" + format_shortest(*r.tolerance));
+        EXPECT_EQ(r.dt, 2e-3);
+        EXPECT_EQ(r.window, "early");
+        continue;
+      }
+      // Every other sleeve run is solved to the scene's own tolerance and has no solver error.
+      EXPECT_EQ(r.tolerance, std::optional<double>(1e-8)) << r.series << " " << r.setting;
+      EXPECT_FALSE(r.solver_error.has_value()) << r.series << " " << r.setting;
+      if (r.method == method.name && r.series == "mesh" && r.setting == "12x9 dt=0.002") mesh_12x9 = &r;
+    }
+    ASSERT_EQ(at.size(), 6u);
+    ASSERT_NE(mesh_12x9, nullptr);
+    const ConvergenceRow& tight = *at.at(1e-12);
+    ASSERT_TRUE(tight.solver_error && tight.solver_energy_error);
+    EXPECT_EQ(*tight.solver_error, 0.0);
+    EXPECT_EQ(*tight.solver_energy_error, 0.0);
+    EXPECT_NE(tight.note.find("solver reference"), std::string::npos) << tight.note;
+    for (const auto& [tolerance, r] : at) {
+      ASSERT_TRUE(r->solver_error && r->discretization_error && r->discretization_energy_error) << tolerance;
+      EXPECT_TRUE(std::isfinite(r->error)) << tolerance;
+      EXPECT_EQ(*r->discretization_error, tight.error) << tolerance;
+      EXPECT_EQ(*r->discretization_energy_error, *tight.energy_error) << tolerance;
+      EXPECT_EQ(r->solver_reference_folds_circumferential, tight.folds_circumferential) << tolerance;
+      EXPECT_EQ(r->solver_reference_folds_axial, tight.folds_axial) << tolerance;
+      // |total − discretisation| <= |u − u_tight| / |u_ref| = solver error · RMS|u_tight| / RMS|u_ref|.
+      EXPECT_LE(std::abs(r->error - *r->discretization_error),
+                *r->solver_error * tight.value / r->reference_value * (1 + 1e-9) + 1e-15)
+          << tolerance;
+    }
+    EXPECT_GT(*at.at(1e-8)->solver_error, 0.0);
+    EXPECT_GT(*at.at(1e-3)->solver_error, *at.at(1e-8)->solver_error);
+    EXPECT_GT(*at.at(1e-2)->solver_error, *at.at(1e-5)->solver_error);
+    EXPECT_LT(at.at(1e-2)->solver_iterations, tight.solver_iterations);
+    // The run at the scene's own tolerance is the mesh series' run.
+    EXPECT_EQ(at.at(1e-8)->wall_seconds, mesh_12x9->wall_seconds);
+    EXPECT_EQ(at.at(1e-8)->error, mesh_12x9->error);
+  }
+}
+
+// A tolerance-series row for summarize_tolerance_series (only the fields it reads).
+ConvergenceRow tolerance_row(double dt, double tolerance, const std::string& window, double solver_error,
+                             double discretization_error, double energy_error, double circumferential, double axial) {
+  ConvergenceRow r;
+  r.case_name = "sleeve_made_up";
+  r.method = "loop_one_point";
+  r.series = "tolerance";
+  r.window = window;
+  r.dt = dt;
+  r.tolerance = tolerance;
+  r.error = 0.5;
+  r.solver_error = solver_error;
+  r.discretization_error = discretization_error;
+  r.solver_energy_error = energy_error;
+  r.folds_circumferential = circumferential;
+  r.folds_axial = axial;
+  return r;
+}
+
+// The rule on made-up rows (ratio 1/10; baseline 1e-8: 1e-8 is a candidate and a baseline run,
+// 1e-9 a baseline run, 1e-12 the tight run; amplification limit 1e3):
+//  - dt 1 ms, "early" (discretisation error 0.01, bound 1e-3): 1e-2 passes (5e-4), 1e-3 fails
+//    (2e-3), 1e-4 and 1e-8 pass: the loosest passing with every tighter candidate passing is 1e-4;
+//    "long": the baseline runs' solver error 0.5 is 5e8 times 1e-9, so the window is unresolved
+//    and does not count. End state: the baseline runs span 10 % energy and 5–6 / 1 folds; 1e-3
+//    (20 %) and 1e-4 (7 folds) lie outside (no energy discretisation error given).
+//  - dt 0.5 ms: "early" passes down from 1e-2, "long" (bound 0.03) from 1e-3.
+// Recommended: the tightest of 1e-4, 1e-2, 1e-3.
+TEST(ConvergenceStudy, ToleranceRuleOnMadeUpRows) {
+  std::vector<ConvergenceRow> rows;
+  auto add = [&](double dt, double tolerance, double early, double late, double energy, double circ, double axial) {
+    rows.push_back(tolerance_row(dt, tolerance, "early", early, dt == 1e-3 ? 0.01 : 0.02, energy, circ, axial));
+    rows.push_back(tolerance_row(dt, tolerance, "long", late, 0.3, energy, circ, axial));
+  };
+  add(1e-3, 1e-2, 5e-4, 0.6, 0.05, 5, 1);
+  add(1e-3, 1e-3, 2e-3, 0.4, 0.2, 6, 1);
+  add(1e-3, 1e-4, 1e-5, 0.5, 0.0, 7, 1);
+  add(1e-3, 1e-8, 1e-9, 0.5, 0.0, 5, 1);
+  add(1e-3, 1e-9, 1e-10, 0.5, 0.1, 6, 1);
+  add(1e-3, 1e-12, 0.0, 0.0, 0.0, 5, 1);
+  add(5e-4, 1e-2, 1e-3, 0.05, 0.0, 5, 1);
+  add(5e-4, 1e-3, 1e-4, 0.01, 0.0, 5, 1);
+  add(5e-4, 1e-4, 1e-5, 0.001, 0.0, 5, 1);
+  add(5e-4, 1e-9, 1e-10, 1e-9, 0.0, 5, 1);
+  add(5e-4, 1e-12, 0.0, 0.0, 0.0, 5, 1);
+  ConvergenceRow other = rows.front();  // rows of other series are ignored
+  other.series = "mesh";
+  other.solver_error = 1.0;
+  rows.push_back(other);
+
+  const ToleranceSummary summary = summarize_tolerance_series(rows);
+  ASSERT_EQ(summary.settings.size(), 2u);
+  const ToleranceSettingCheck& a = summary.settings[0];
+  EXPECT_EQ(a.dt, 1e-3);
+  EXPECT_EQ(a.tight_tolerance, 1e-12);
+  EXPECT_EQ(a.candidates, (std::vector<double>{1e-2, 1e-3, 1e-4, 1e-8}));
+  ASSERT_EQ(a.windows.size(), 2u);
+  EXPECT_EQ(a.windows[0].window, "early");
+  EXPECT_TRUE(a.windows[0].resolved);
+  EXPECT_EQ(a.windows[0].loosest, std::optional<double>(1e-4));
+  EXPECT_EQ(a.windows[0].discretization_error, 0.01);
+  EXPECT_EQ(a.windows[0].baseline_solver_error, 1e-9);
+  EXPECT_NEAR(a.windows[0].amplification, 0.1, 1e-15);
+  EXPECT_FALSE(a.windows[1].resolved);
+  EXPECT_EQ(a.windows[1].baseline_solver_error, 0.5);
+  EXPECT_NEAR(a.windows[1].amplification, 5e8, 1e-6);
+  EXPECT_EQ(a.windows[1].loosest, std::nullopt);
+  EXPECT_EQ(a.energy_spread, 0.1);
+  EXPECT_EQ(a.folds_circumferential_min, 5.0);
+  EXPECT_EQ(a.folds_circumferential_max, 6.0);
+  EXPECT_EQ(a.folds_axial_min, 1.0);
+  EXPECT_EQ(a.folds_axial_max, 1.0);
+  EXPECT_EQ(a.outside_spread, (std::vector<double>{1e-3, 1e-4}));
+  const ToleranceSettingCheck& b = summary.settings[1];
+  EXPECT_EQ(b.candidates, (std::vector<double>{1e-2, 1e-3, 1e-4}));
+  EXPECT_EQ(b.windows[0].loosest, std::optional<double>(1e-2));
+  EXPECT_TRUE(b.windows[1].resolved);
+  EXPECT_EQ(b.windows[1].loosest, std::optional<double>(1e-3));
+  EXPECT_TRUE(b.outside_spread.empty());
+  EXPECT_EQ(summary.recommended, std::optional<double>(1e-4));
+
+  std::ostringstream md;
+  write_tolerance_summary_markdown(md, summary);
+  EXPECT_NE(md.str().find("Recommended tolerance by the rule: 1e-04\n"), std::string::npos) << md.str();
+  EXPECT_NE(md.str().find("| sleeve_made_up | loop_one_point | 0.001 | long | 0.3 | 0.5 | 5e+08 | no | none |"),
+            std::string::npos)
+      << md.str();
+
+  // With an energy discretisation error of 2.5 the energy bound is 0.25: 1e-3's 20 % is inside,
+  // 1e-4's seven folds are not.
+  std::vector<ConvergenceRow> with_energy = rows;
+  for (ConvergenceRow& r : with_energy) r.discretization_energy_error = 2.5;
+  EXPECT_EQ(summarize_tolerance_series(with_energy).settings[0].outside_spread, (std::vector<double>{1e-4}));
+
+  // A resolved window in which even the tightest candidate fails: no recommendation.
+  ConvergenceRow& b_early_1e4 = rows[16];
+  ASSERT_EQ(b_early_1e4.dt, 5e-4);
+  ASSERT_EQ(*b_early_1e4.tolerance, 1e-4);
+  ASSERT_EQ(b_early_1e4.window, "early");
+  b_early_1e4.solver_error = 0.05;  // bound 2e-3
+  const ToleranceSummary failing = summarize_tolerance_series(rows);
+  EXPECT_EQ(failing.settings[1].windows[0].loosest, std::nullopt);
+  EXPECT_EQ(failing.recommended, std::nullopt);
+  // No tolerance series: nothing.
+  EXPECT_TRUE(summarize_tolerance_series({other}).settings.empty());
+  std::ostringstream none;
+  write_tolerance_summary_markdown(none, summarize_tolerance_series({other}));
+  EXPECT_TRUE(none.str().empty());
 }
 
 TEST(ConvergenceStudy, SampleTimesMustBeMultiplesOfEveryTimeStep) {
@@ -269,7 +447,8 @@ TEST(ConvergenceStudy, CsvHasTheDocumentedColumnsAndOneLinePerRun) {
       "order",    "quantity",     "value",             "reference_value",   "reference_precision", "reference",
       "note",     "elastic_energy", "reference_elastic_energy", "energy_error", "folds_circumferential",
       "folds_axial", "reference_folds_circumferential", "reference_folds_axial", "fold_difference_circumferential",
-      "fold_difference_axial"};
+      "fold_difference_axial", "tolerance", "solver_error", "discretization_error", "solver_energy_error",
+      "discretization_energy_error", "solver_reference_folds_circumferential", "solver_reference_folds_axial"};
   EXPECT_EQ(results_csv_columns(), expected);
 
   const std::vector<Method> loop = {convergence_methods()[0], convergence_methods()[1]};
@@ -284,18 +463,42 @@ TEST(ConvergenceStudy, CsvHasTheDocumentedColumnsAndOneLinePerRun) {
             "case,method,series,window,setting,vertices,dofs,h,dt,steps,wall_seconds,solver_iterations,error,order,"
             "quantity,value,reference_value,reference_precision,reference,note,elastic_energy,reference_elastic_energy,"
             "energy_error,folds_circumferential,folds_axial,reference_folds_circumferential,reference_folds_axial,"
-            "fold_difference_circumferential,fold_difference_axial");
+            "fold_difference_circumferential,fold_difference_axial,tolerance,solver_error,discretization_error,"
+            "solver_energy_error,discretization_energy_error,solver_reference_folds_circumferential,"
+            "solver_reference_folds_axial");
   EXPECT_EQ(nth_line(text, 1).rfind("plate_ss_uniform,loop_one_point,mesh,static,4x4,25,", 0), 0u) << text;
   EXPECT_NE(nth_line(text, 1).find(",\"a, \"\"quoted\"\" note\""), std::string::npos) << text;
   EXPECT_NE(nth_line(text, 2).find(",mesh,static,8x8,81,"), std::string::npos) << text;
-  // A plate row has no post-buckling measures: the nine last fields are empty.
+  // A plate row has no post-buckling measures, no iterative solver and no tolerance series: the
+  // sixteen last fields are empty.
   const std::string line = nth_line(text, 2);
-  EXPECT_EQ(line.substr(line.size() - 9), std::string(9, ',')) << line;
+  EXPECT_EQ(line.substr(line.size() - 16), std::string(16, ',')) << line;
 
   std::ostringstream md;
   write_results_markdown(md, rows);
   const std::string table = md.str();
   EXPECT_EQ(static_cast<size_t>(std::count(table.begin(), table.end(), '\n')), rows.size() + 2);
+}
+
+// docs/convergence.md documents every column of results.csv, in the order written: the names in
+// the first cells of the table under "## results.csv" (a cell may name several, `a`, `b`).
+TEST(ConvergenceStudy, CsvColumnsAreTheDocumentedOnes) {
+  std::ifstream in(CLOTHSIM_SOURCE_DIR "/docs/convergence.md");
+  ASSERT_TRUE(in) << "docs/convergence.md";
+  std::vector<std::string> documented;
+  bool section = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("## ", 0) == 0) section = line == "## results.csv";
+    if (!section || line.rfind("| `", 0) != 0) continue;
+    const std::string cell = line.substr(1, line.find('|', 1) - 1);
+    for (size_t open = cell.find('`'); open != std::string::npos; open = cell.find('`', open + 1)) {
+      const size_t close = cell.find('`', open + 1);
+      ASSERT_NE(close, std::string::npos) << line;
+      documented.push_back(cell.substr(open + 1, close - open - 1));
+      open = close;
+    }
+  }
+  EXPECT_EQ(documented, results_csv_columns());
 }
 
 }  // namespace
