@@ -1,10 +1,15 @@
 // render_bench: time to render one 1280 x 720 frame with 4x MSAA of a smooth ~50k-triangle
 // mesh (a finely tessellated wavy cylinder generated here) over a ground plane, with and without
-// a wireframe overlay. `render_bench --png=PATH` also writes the rendered frame for inspection.
+// a wireframe overlay (BM_render_1280x720_msaa4: Renderer::render, i.e. everything from the Frame to the RGB
+// image in memory, no PNG). BM_render_phases splits the same work into its phases
+// (RenderPhases, with glFinish between them; counters in ms per frame), BM_write_png times the
+// PNG encoding and writing of the rendered frame (write_png into a temporary folder), which a
+// run adds per frame. `render_bench --png=PATH` also writes the rendered frame for inspection.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <numbers>
 #include <string>
@@ -12,6 +17,8 @@
 
 #include "render/png_io.hpp"
 #include "render/renderer.hpp"
+
+#include <unistd.h>
 
 namespace {
 
@@ -98,6 +105,62 @@ BENCHMARK(BM_render_1280x720_msaa4)
     ->ArgName("wireframe")
     ->Arg(0)
     ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->Repetitions(7)
+    ->ReportAggregatesOnly(true)
+    ->UseRealTime();
+
+// The phases of render() (RenderPhases), with glFinish between them: counters in ms per frame
+// (the iteration time is their sum plus the timing's own overhead).
+void BM_render_phases(benchmark::State& state) {
+  const Frame frame = bench_frame(state.range(0) != 0);
+  benchmark::DoNotOptimize(renderer().render(frame));
+  renderer().set_phase_timing(true);
+  RenderPhases sum;
+  for (auto _ : state) {
+    Image image = renderer().render(frame);
+    benchmark::DoNotOptimize(image.rgb.data());
+    const RenderPhases& p = renderer().last_phases();
+    sum.prepare += p.prepare;
+    sum.upload += p.upload;
+    sum.draw += p.draw;
+    sum.raster += p.raster;
+    sum.resolve += p.resolve;
+    sum.read += p.read;
+    sum.convert += p.convert;
+  }
+  renderer().set_phase_timing(false);
+  const double n = static_cast<double>(state.iterations());
+  state.counters["prepare_ms"] = sum.prepare / n;
+  state.counters["upload_ms"] = sum.upload / n;
+  state.counters["draw_ms"] = sum.draw / n;
+  state.counters["raster_ms"] = sum.raster / n;
+  state.counters["resolve_ms"] = sum.resolve / n;
+  state.counters["read_ms"] = sum.read / n;
+  state.counters["convert_ms"] = sum.convert / n;
+}
+BENCHMARK(BM_render_phases)
+    ->ArgName("wireframe")
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(1.0)
+    ->Repetitions(7)
+    ->ReportAggregatesOnly(true)
+    ->UseRealTime();
+
+// write_png of the rendered frame (no wireframe): encoding, writing a temporary file, renaming.
+void BM_write_png(benchmark::State& state) {
+  const Image image = renderer().render(bench_frame(false));
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("render_bench_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "frame.png").string();
+  for (auto _ : state) write_png(path, image);
+  state.counters["bytes"] = static_cast<double>(std::filesystem::file_size(path));
+  std::filesystem::remove_all(dir);
+}
+BENCHMARK(BM_write_png)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0)
     ->Repetitions(7)

@@ -5,6 +5,7 @@
 #include <GL/osmesa.h>  // includes GL/gl.h and GL/glext.h; GL_GLEXT_PROTOTYPES is set by CMake
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -319,6 +320,17 @@ struct Renderer::Impl {
   GLuint resolve_fbo = 0, resolve_color = 0;
   std::vector<std::uint8_t> read_buffer;  // bottom-up RGBA rows from glReadPixels
 
+  // Phase timing (set_phase_timing): lap() charges the time since the previous lap to a phase.
+  bool time_phases = false;
+  RenderPhases phases;
+  std::chrono::steady_clock::time_point lap_start;
+  void lap(double RenderPhases::*phase) {
+    if (!time_phases) return;
+    const auto now = std::chrono::steady_clock::now();
+    phases.*phase += std::chrono::duration<double, std::milli>(now - lap_start).count();
+    lap_start = now;
+  }
+
   Impl(int width, int height, int samples);
   ~Impl();
   void make_current();
@@ -537,12 +549,14 @@ void Renderer::Impl::ensure_framebuffers(int width, int height) {
 
 void Renderer::Impl::draw_mesh(const Mesh& mesh, const std::vector<float>& vertices) {
   if (mesh.triangles.empty()) return;
+  lap(&RenderPhases::draw);
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(vertices.size() * sizeof(float)),
                vertices.data(), GL_STREAM_DRAW);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                static_cast<GLsizeiptr>(mesh.triangles.size() * sizeof(unsigned)),
                mesh.triangles.data(), GL_STREAM_DRAW);
   check("uploading a mesh");  // no draw call on a buffer without storage
+  lap(&RenderPhases::upload);
   glEnableVertexAttribArray(0);
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
@@ -553,6 +567,7 @@ void Renderer::Impl::draw_mesh(const Mesh& mesh, const std::vector<float>& verti
   glUniform3fv(surface_back, 1, mesh.back_color.data());
   glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size()), GL_UNSIGNED_INT,
                  nullptr);
+  lap(&RenderPhases::draw);
 }
 
 void Renderer::Impl::draw_ground(const Frame& frame, const Vec3f& centre, float half_size) {
@@ -563,8 +578,10 @@ void Renderer::Impl::draw_ground(const Frame& frame, const Vec3f& centre, float 
   const float vertices[] = {x0, y, z0, 0, 1, 0, x0, y, z1, 0, 1, 0,
                             x1, y, z1, 0, 1, 0, x1, y, z0, 0, 1, 0};
   const unsigned indices[] = {0, 1, 2, 0, 2, 3};
+  lap(&RenderPhases::draw);
   glBufferData(GL_ARRAY_BUFFER, sizeof(vertices), vertices, GL_STREAM_DRAW);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, sizeof(indices), indices, GL_STREAM_DRAW);
+  lap(&RenderPhases::upload);
   glEnableVertexAttribArray(0);
   glEnableVertexAttribArray(1);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
@@ -577,28 +594,36 @@ void Renderer::Impl::draw_ground(const Frame& frame, const Vec3f& centre, float 
   glUniform2f(surface_ground_centre, centre[0], centre[2]);
   glUniform2f(surface_ground_fade, 0.25f * half_size, 0.8f * half_size);
   glDrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, nullptr);
+  lap(&RenderPhases::draw);
 }
 
 void Renderer::Impl::draw_lines(const Lines& lines) {
   if (lines.segments.empty()) return;
+  lap(&RenderPhases::draw);
   glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(lines.positions.size() * sizeof(float)),
                lines.positions.data(), GL_STREAM_DRAW);
   glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                static_cast<GLsizeiptr>(lines.segments.size() * sizeof(unsigned)),
                lines.segments.data(), GL_STREAM_DRAW);
   check("uploading lines");
+  lap(&RenderPhases::upload);
   glEnableVertexAttribArray(0);
   glDisableVertexAttribArray(1);
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
   glUniform3fv(line_color, 1, lines.color.data());
   glLineWidth(std::clamp(lines.width, line_width_range[0], line_width_range[1]));
   glDrawElements(GL_LINES, static_cast<GLsizei>(lines.segments.size()), GL_UNSIGNED_INT, nullptr);
+  lap(&RenderPhases::draw);
 }
 
 Image Renderer::Impl::render(const Frame& frame) {
   if (!failure.empty()) {
     throw std::runtime_error("Renderer: unusable after an earlier failure (" + failure +
                              "); create a new Renderer");
+  }
+  if (time_phases) {
+    phases = RenderPhases{};
+    lap_start = std::chrono::steady_clock::now();
   }
   // Validate everything before touching GL.
   require(
@@ -672,6 +697,7 @@ Image Renderer::Impl::render(const Frame& frame) {
   image.width = frame.width;
   image.height = frame.height;
   image.rgb.resize(3 * width * rows);
+  lap(&RenderPhases::prepare);
 
   // Any failure from here on leaves the context in an unknown state (see `failure`).
   try {
@@ -709,18 +735,28 @@ Image Renderer::Impl::render(const Frame& frame) {
       for (const Lines& lines : frame.lines) draw_lines(lines);
     }
     check("drawing");
+    lap(&RenderPhases::draw);
+    if (time_phases) {
+      glFinish();
+      lap(&RenderPhases::raster);
+    }
 
     // Resolve the samples, then read back (GL rows run bottom-up: flip to top row first).
     glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
     glBlitFramebuffer(0, 0, frame.width, frame.height, 0, 0, frame.width, frame.height,
                       GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    if (time_phases) {
+      glFinish();
+      lap(&RenderPhases::resolve);
+    }
     glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     // RGBA is Mesa's fast read-back path (a plain copy); dropping alpha here is cheaper than
     // letting GL convert to RGB.
     glReadPixels(0, 0, frame.width, frame.height, GL_RGBA, GL_UNSIGNED_BYTE, read_buffer.data());
     check("reading back the image");
+    lap(&RenderPhases::read);
 
     for (std::size_t y = 0; y < rows; ++y) {
       const std::uint8_t* source = read_buffer.data() + 4 * width * (rows - 1 - y);
@@ -731,6 +767,7 @@ Image Renderer::Impl::render(const Frame& frame) {
         target[3 * x + 2] = source[4 * x + 2];
       }
     }
+    lap(&RenderPhases::convert);
   } catch (const std::exception& e) {
     if (failure.empty()) failure = e.what();
     throw;
@@ -753,6 +790,8 @@ Image Renderer::render(const Frame& frame) {
 }
 
 const RendererInfo& Renderer::info() const { return impl_->info; }
+void Renderer::set_phase_timing(bool on) { impl_->time_phases = on; }
+const RenderPhases& Renderer::last_phases() const { return impl_->phases; }
 int Renderer::max_width() const { return impl_->max_width; }
 int Renderer::max_height() const { return impl_->max_height; }
 

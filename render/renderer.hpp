@@ -19,6 +19,21 @@ struct RendererInfo {
   int samples = 0;  // MSAA samples per pixel actually used (1: no multisampling)
 };
 
+// Wall-clock time [ms] of the phases of one render(), filled only while phase timing is on
+// (Renderer::set_phase_timing). Timing inserts glFinish after the drawing and after the resolve,
+// so that llvmpipe's deferred rasterisation is charged to the phase that queued it; the image is
+// the same with and without timing.
+struct RenderPhases {
+  double prepare = 0;  // validation, near/far planes, vertex data (normals when missing), buffers
+  double upload = 0;   // glBufferData of vertices and indices
+  double draw = 0;     // draw calls: vertex shading, clipping and binning (calling thread)
+  double raster = 0;   // glFinish after the draw calls: rasterisation and fragment shading
+  double resolve = 0;  // MSAA resolve (glBlitFramebuffer into the single-sample buffer, glFinish)
+  double read = 0;     // glReadPixels of the resolved image
+  double convert = 0;  // rows flipped to top first, RGBA to RGB
+  double total() const { return prepare + upload + draw + raster + resolve + read + convert; }
+};
+
 // Owns one OSMesa context (created in the constructor, destroyed in the destructor). The
 // context is made current on the calling thread by the constructor and by every render(); a
 // Renderer must be used from one thread at a time. Framebuffers are allocated on the first
@@ -51,6 +66,10 @@ class Renderer {
   Image render(const Frame& frame);
 
   const RendererInfo& info() const;
+  // Phase timing of render() (off by default; for benchmarks): see RenderPhases.
+  void set_phase_timing(bool on);
+  // The phases of the last render() while phase timing was on.
+  const RenderPhases& last_phases() const;
   int max_width() const;
   int max_height() const;
 

@@ -249,6 +249,24 @@ TEST(RendererTest, TwoRenderersCanBeUsedAlternately) {
   EXPECT_EQ(moved.render(triangle_frame(3)).rgb, first.rgb);
 }
 
+TEST(RendererTest, PhaseTimingReportsPhasesAndKeepsTheImage) {
+  Frame frame = triangle_frame(3);
+  frame.ground = true;
+  frame.ground_height = -1;
+  Renderer renderer(kWidth, kHeight);
+  const Image untimed = renderer.render(frame);
+  renderer.set_phase_timing(true);
+  const Image timed = renderer.render(frame);
+  const RenderPhases phases = renderer.last_phases();
+  renderer.set_phase_timing(false);
+  EXPECT_EQ(timed.rgb, untimed.rgb);  // the glFinish calls of timing change nothing drawn
+  for (const double phase : {phases.prepare, phases.upload, phases.draw, phases.raster, phases.resolve,
+                             phases.read, phases.convert})
+    EXPECT_GE(phase, 0.0);
+  EXPECT_GT(phases.total(), 0.0);
+  EXPECT_GT(phases.raster + phases.resolve, 0.0);
+}
+
 // The 12 triangles of the box [lo, hi], outward-facing.
 Mesh box_mesh(const Vec3f& lo, const Vec3f& hi) {
   Mesh mesh;
