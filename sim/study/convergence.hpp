@@ -119,6 +119,12 @@ struct SleeveMesh {
   int rings = 0;
 };
 
+// One setting of a sleeve's tolerance series: a method at a time step (on the case's tolerance_mesh).
+struct ToleranceSetting {
+  std::string method;  // Method::name; a setting whose method is not in the study is skipped
+  double dt = 1e-3;    // [s]
+};
+
 struct PlateStudyCase {
   AnalyticPlate plate;
   std::vector<int> divisions;  // grids of n × n cells, coarse to fine
@@ -145,18 +151,16 @@ struct SleeveStudyCase {
   // Methods that also run the time-step series (the others run the mesh series only); empty: all.
   std::vector<std::string> dt_series_methods;
   // Tolerance series (the linear solver's relative-residual tolerance, the scene's
-  // solver.tolerance): the methods in tolerance_series_methods on tolerance_mesh at each time step
-  // of tolerance_dts, once with every tolerance of `tolerances` and once with tight_tolerance,
-  // the solver reference of that setting (its solver error is 0 by definition). Each run's error
-  // is reported against the study's reference (total error), against the tight run of its setting
-  // (solver error), and the tight run's against the reference (discretisation error). Empty
-  // `tolerances`: no tolerance series.
+  // solver.tolerance): each of tolerance_settings (a method at a time step) on tolerance_mesh, once
+  // with every tolerance of `tolerances` and once with tight_tolerance, the solver reference of
+  // that setting (its solver error is 0 by definition). Each run's error is reported against the
+  // study's reference (total error), against the tight run of its setting (solver error), and the
+  // tight run's against the reference (discretisation error). Empty `tolerances`: no tolerance
+  // series.
   std::vector<double> tolerances;  // loose to tight, each > tight_tolerance
   double tight_tolerance = 1e-12;
   SleeveMesh tolerance_mesh;
-  std::vector<double> tolerance_dts;  // [s]
-  // Methods that run the tolerance series; empty: all.
-  std::vector<std::string> tolerance_series_methods;
+  std::vector<ToleranceSetting> tolerance_settings;
   SleeveMesh reference_mesh;       // the reference run: this mesh, reference_dt, reference_method
   double reference_dt = 5e-4;      // [s]
   std::string reference_method = "loop_three_point";
