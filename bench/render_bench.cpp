@@ -123,6 +123,8 @@ void BM_render_phases(benchmark::State& state) {
     benchmark::DoNotOptimize(image.rgb.data());
     const RenderPhases& p = renderer().last_phases();
     sum.prepare += p.prepare;
+    sum.backdrop += p.backdrop;
+    sum.restore += p.restore;
     sum.upload += p.upload;
     sum.draw += p.draw;
     sum.raster += p.raster;
@@ -133,6 +135,8 @@ void BM_render_phases(benchmark::State& state) {
   renderer().set_phase_timing(false);
   const double n = static_cast<double>(state.iterations());
   state.counters["prepare_ms"] = sum.prepare / n;
+  state.counters["backdrop_ms"] = sum.backdrop / n;
+  state.counters["restore_ms"] = sum.restore / n;
   state.counters["upload_ms"] = sum.upload / n;
   state.counters["draw_ms"] = sum.draw / n;
   state.counters["raster_ms"] = sum.raster / n;

@@ -37,13 +37,18 @@ void main() {
 // Back faces use the back colour and the flipped normal. Vertices without a usable normal fall
 // back to the facet normal from screen-space derivatives. The ground is matte and fades into
 // the background with distance from its centre.
-constexpr const char* kSurfaceFragmentShader = R"(#version 330 core
+// The source is compiled twice, with GROUND defined as 0 (meshes) and as 1 (the ground), into
+// two programs: llvmpipe runs both sides of a branch under a mask, so one program with a
+// uniform switch shaded every pixel of the ground with the cloth's lighting too (and every
+// cloth pixel with the ground's fade). The arithmetic of each side is unchanged, and so is every
+// pixel (checked on render_bench's frame and on the runs' frames).
+constexpr const char* kSurfaceFragmentShaderBody = R"(
 in vec3 v_view_position;
 in vec3 v_view_normal;
 in vec3 v_world_position;
 uniform vec3 u_front_color;
 uniform vec3 u_back_color;
-uniform int u_is_ground;
+const bool kIsGround = GROUND != 0;
 uniform vec3 u_background;
 uniform vec2 u_ground_centre;
 uniform vec2 u_ground_fade;
@@ -77,10 +82,10 @@ void main() {
   } else {
     n = facet;
   }
-  vec3 base = (u_is_ground != 0 || front) ? u_front_color : u_back_color;
+  vec3 base = (kIsGround || front) ? u_front_color : u_back_color;
   vec3 v = normalize(-v_view_position);
   vec3 color;
-  if (u_is_ground == 0) {
+  if (!kIsGround) {
     color = kAmbient * base + light(n, v, kKeyDirection, kKey, base) +
             light(n, v, kFillDirection, kFill, base);
   } else {
@@ -107,6 +112,11 @@ void main() { o_color = vec4(u_color, 1.0); }
 )";
 
 constexpr float kGroundGrey = 0.92f;
+
+std::string surface_fragment_source(bool ground) {
+  return std::string("#version 330 core\n#define GROUND ") + (ground ? "1" : "0") + "\n" +
+         kSurfaceFragmentShaderBody;
+}
 
 std::string gl_error_name(GLenum error) {
   switch (error) {
@@ -285,6 +295,94 @@ struct DepthRange {
   }
 };
 
+// A rectangle of pixels [x0, x1) × [y0, y1) in GL window coordinates (rows from the bottom).
+struct PixelRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+};
+
+PixelRect whole(int width, int height) { return {0, 0, width, height}; }
+
+// What the backdrop depends on: image size and background; with a ground also the ground and
+// the camera matrices (without one the backdrop is the cleared buffers, whatever the camera and
+// the near and far planes, which follow the meshes).
+std::vector<float> backdrop_key_for(const Frame& frame, const Mat4f& view, const Mat4f& projection,
+                                    const Vec3f& ground_centre, float ground_half_size) {
+  std::vector<float> key = {static_cast<float>(frame.width), static_cast<float>(frame.height),
+                            frame.background[0], frame.background[1], frame.background[2],
+                            frame.ground ? 1.0f : 0.0f};
+  if (frame.ground) {
+    key.insert(key.end(), {ground_centre[0], ground_centre[1], ground_centre[2], ground_half_size});
+    key.insert(key.end(), view.begin(), view.end());
+    key.insert(key.end(), projection.begin(), projection.end());
+  }
+  return key;
+}
+
+// The pixels the frame's meshes and lines can touch: the bounding rectangle of their vertices'
+// projections, widened by 2 pixels (sample positions, rounding) and by the widest line, within
+// the image; the whole image if a vertex lies on or behind the camera's plane. A triangle or
+// line with every vertex in front of the camera projects into the convex hull of its vertices'
+// images, and so does whatever of it survives clipping.
+PixelRect drawn_rect(const Frame& frame, const Mat4f& view, const Mat4f& projection,
+                     float widest_line) {
+  double m[16];  // projection · view, column-major
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) {
+      double sum = 0;
+      for (int k = 0; k < 4; ++k) {
+        sum += static_cast<double>(projection[static_cast<std::size_t>(4 * k + r)]) *
+               view[static_cast<std::size_t>(4 * c + k)];
+      }
+      m[4 * c + r] = sum;
+    }
+  }
+  double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x;
+  double hi_x = -lo_x, hi_y = -lo_x;
+  bool behind = false;
+  auto add_all = [&](const std::vector<float>& positions) {
+    for (std::size_t i = 0; i + 2 < positions.size(); i += 3) {
+      const double x = positions[i], y = positions[i + 1], z = positions[i + 2];
+      const double w = m[3] * x + m[7] * y + m[11] * z + m[15];
+      if (!(w > 0)) {
+        behind = true;
+        return;
+      }
+      const double sx = (m[0] * x + m[4] * y + m[8] * z + m[12]) / w;
+      const double sy = (m[1] * x + m[5] * y + m[9] * z + m[13]) / w;
+      lo_x = std::min(lo_x, sx);
+      hi_x = std::max(hi_x, sx);
+      lo_y = std::min(lo_y, sy);
+      hi_y = std::max(hi_y, sy);
+    }
+  };
+  bool lines = false;
+  for (const Mesh& mesh : frame.meshes) {
+    if (!mesh.triangles.empty() && !behind) add_all(mesh.positions);
+  }
+  for (const Lines& l : frame.lines) {
+    if (l.segments.empty() || behind) continue;
+    add_all(l.positions);
+    lines = true;
+  }
+  if (behind) return whole(frame.width, frame.height);
+  if (!(lo_x <= hi_x && lo_y <= hi_y)) return {};  // nothing is drawn
+  const double margin = 2.0 + (lines ? std::ceil(widest_line) : 0.0);
+  const double w = frame.width, h = frame.height;
+  // Normalised device coordinates to pixels; clamped before converting to int.
+  auto pixel = [](double ndc, double size, double shift) {
+    return std::clamp((0.5 * ndc + 0.5) * size + shift, 0.0, size);
+  };
+  PixelRect rect;
+  rect.x0 = static_cast<int>(std::floor(pixel(lo_x, w, -margin)));
+  rect.x1 = static_cast<int>(std::ceil(pixel(hi_x, w, margin)));
+  rect.y0 = static_cast<int>(std::floor(pixel(lo_y, h, -margin)));
+  rect.y1 = static_cast<int>(std::ceil(pixel(hi_y, h, margin)));
+  return rect.empty() ? PixelRect{} : rect;
+}
+
 }  // namespace
 
 struct Renderer::Impl {
@@ -302,11 +400,12 @@ struct Renderer::Impl {
   RendererInfo info;
   float line_width_range[2] = {1, 1};
 
-  GLuint surface_program = 0;
+  GLuint surface_program = 0;  // meshes (GROUND 0)
+  GLuint ground_program = 0;   // the ground (GROUND 1)
   GLuint line_program = 0;
-  GLint surface_view = -1, surface_projection = -1, surface_front = -1, surface_back = -1,
-        surface_is_ground = -1, surface_background = -1, surface_ground_centre = -1,
-        surface_ground_fade = -1;
+  GLint surface_view = -1, surface_projection = -1, surface_front = -1, surface_back = -1;
+  GLint ground_view = -1, ground_projection = -1, ground_color = -1, ground_background = -1,
+        ground_centre_location = -1, ground_fade_location = -1;
   GLint line_view = -1, line_projection = -1, line_color = -1;
 
   GLuint vao = 0;
@@ -319,6 +418,22 @@ struct Renderer::Impl {
   GLuint ms_fbo = 0, ms_color = 0, ms_depth = 0;
   GLuint resolve_fbo = 0, resolve_color = 0;
   std::vector<std::uint8_t> read_buffer;  // bottom-up RGBA rows from glReadPixels
+
+  // The backdrop: what a frame shows without its meshes and lines (background and ground),
+  // multisampled (colour and depth, backdrop_fbo) and resolved (backdrop_rgb), kept for the
+  // frames that share its size, background and ground (backdrop_key_for). It is
+  // built by the second frame in a row with the same key. A frame drawn over it restores only
+  // the part of ms_fbo that the previous frame drew on (ms_dirty) from backdrop_fbo, draws its
+  // meshes and lines over the ground already there, and resolves and reads back only the
+  // rectangle they can touch; the rest of the image is backdrop_rgb. The pixels are those of
+  // drawing everything afresh: outside the rectangle ms_fbo holds the backdrop's samples, and
+  // the ground drawn before instead of after the meshes loses or wins the same depth tests
+  // (only a sample at exactly the same depth on both could differ).
+  GLuint backdrop_fbo = 0, backdrop_color = 0, backdrop_depth = 0;
+  std::vector<float> backdrop_key;         // of the built backdrop; empty: none
+  std::vector<float> direct_key;           // of the last frame drawn without the backdrop
+  std::vector<std::uint8_t> backdrop_rgb;  // the resolved backdrop, top row first
+  PixelRect ms_dirty;                      // where ms_fbo may differ from backdrop_fbo
 
   // Phase timing (set_phase_timing): lap() charges the time since the previous lap to a phase.
   bool time_phases = false;
@@ -345,7 +460,11 @@ struct Renderer::Impl {
   void draw(const Frame& frame, const std::vector<std::vector<float>>& mesh_vertices, Image& image);
   void draw_mesh(const Mesh& mesh, const std::vector<float>& vertices);
   void draw_lines(const Lines& lines);
-  void draw_ground(const Frame& frame, const Vec3f& centre, float half_size);
+  void draw_ground(const Frame& frame, const Mat4f& view, const Mat4f& projection,
+                   const Vec3f& centre, float half_size);
+  void build_backdrop(const Frame& frame, const Mat4f& view, const Mat4f& projection,
+                      const Vec3f& centre, float half_size);
+  void read_back(const PixelRect& rect, std::uint8_t* rgb);
 };
 
 Renderer::Impl::Impl(int width, int height, int samples)
@@ -467,15 +586,20 @@ void Renderer::Impl::setup_pipeline(int requested_samples) {
                              std::to_string(std::min(max_renderbuffer, max_viewport[1])));
   }
 
-  surface_program = link_program(kSurfaceVertexShader, kSurfaceFragmentShader, "surface");
+  surface_program =
+      link_program(kSurfaceVertexShader, surface_fragment_source(false).c_str(), "surface");
   surface_view = uniform(surface_program, "u_view");
   surface_projection = uniform(surface_program, "u_projection");
   surface_front = uniform(surface_program, "u_front_color");
   surface_back = uniform(surface_program, "u_back_color");
-  surface_is_ground = uniform(surface_program, "u_is_ground");
-  surface_background = uniform(surface_program, "u_background");
-  surface_ground_centre = uniform(surface_program, "u_ground_centre");
-  surface_ground_fade = uniform(surface_program, "u_ground_fade");
+  ground_program =
+      link_program(kSurfaceVertexShader, surface_fragment_source(true).c_str(), "ground");
+  ground_view = uniform(ground_program, "u_view");
+  ground_projection = uniform(ground_program, "u_projection");
+  ground_color = uniform(ground_program, "u_front_color");
+  ground_background = uniform(ground_program, "u_background");
+  ground_centre_location = uniform(ground_program, "u_ground_centre");
+  ground_fade_location = uniform(ground_program, "u_ground_fade");
   line_program = link_program(kLineVertexShader, kLineFragmentShader, "line");
   line_view = uniform(line_program, "u_view");
   line_projection = uniform(line_program, "u_projection");
@@ -499,10 +623,16 @@ void Renderer::Impl::setup_pipeline(int requested_samples) {
 void Renderer::Impl::delete_framebuffers() {
   glDeleteFramebuffers(1, &ms_fbo);
   glDeleteFramebuffers(1, &resolve_fbo);
+  glDeleteFramebuffers(1, &backdrop_fbo);
   glDeleteRenderbuffers(1, &ms_color);
   glDeleteRenderbuffers(1, &ms_depth);
   glDeleteRenderbuffers(1, &resolve_color);
+  glDeleteRenderbuffers(1, &backdrop_color);
+  glDeleteRenderbuffers(1, &backdrop_depth);
   ms_fbo = resolve_fbo = ms_color = ms_depth = resolve_color = 0;
+  backdrop_fbo = backdrop_color = backdrop_depth = 0;
+  backdrop_key.clear();
+  direct_key.clear();
   fb_width = fb_height = 0;
 }
 
@@ -562,7 +692,6 @@ void Renderer::Impl::draw_mesh(const Mesh& mesh, const std::vector<float>& verti
   glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
                         reinterpret_cast<const void*>(3 * sizeof(float)));
-  glUniform1i(surface_is_ground, 0);
   glUniform3fv(surface_front, 1, mesh.color.data());
   glUniform3fv(surface_back, 1, mesh.back_color.data());
   glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(mesh.triangles.size()), GL_UNSIGNED_INT,
@@ -570,7 +699,8 @@ void Renderer::Impl::draw_mesh(const Mesh& mesh, const std::vector<float>& verti
   lap(&RenderPhases::draw);
 }
 
-void Renderer::Impl::draw_ground(const Frame& frame, const Vec3f& centre, float half_size) {
+void Renderer::Impl::draw_ground(const Frame& frame, const Mat4f& view, const Mat4f& projection,
+                                 const Vec3f& centre, float half_size) {
   const float y = frame.ground_height;
   const float x0 = centre[0] - half_size, x1 = centre[0] + half_size;
   const float z0 = centre[2] - half_size, z1 = centre[2] + half_size;
@@ -588,13 +718,82 @@ void Renderer::Impl::draw_ground(const Frame& frame, const Vec3f& centre, float 
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
                         reinterpret_cast<const void*>(3 * sizeof(float)));
   const float grey[3] = {kGroundGrey, kGroundGrey, kGroundGrey};
-  glUniform1i(surface_is_ground, 1);
-  glUniform3fv(surface_front, 1, grey);
-  glUniform3fv(surface_back, 1, grey);
-  glUniform2f(surface_ground_centre, centre[0], centre[2]);
-  glUniform2f(surface_ground_fade, 0.25f * half_size, 0.8f * half_size);
+  glUseProgram(ground_program);
+  glUniformMatrix4fv(ground_view, 1, GL_FALSE, view.data());
+  glUniformMatrix4fv(ground_projection, 1, GL_FALSE, projection.data());
+  glUniform3fv(ground_background, 1, frame.background.data());
+  glUniform3fv(ground_color, 1, grey);
+  glUniform2f(ground_centre_location, centre[0], centre[2]);
+  glUniform2f(ground_fade_location, 0.25f * half_size, 0.8f * half_size);
+  // Pushed further back than the meshes, so that cloth lying on it stays visible.
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(4.0f, 16.0f);
   glDrawElements(GL_TRIANGLES, 6, GL_UNSIGNED_INT, nullptr);
+  glDisable(GL_POLYGON_OFFSET_FILL);
   lap(&RenderPhases::draw);
+}
+
+void Renderer::Impl::build_backdrop(const Frame& frame, const Mat4f& view,
+                                    const Mat4f& projection, const Vec3f& centre,
+                                    float half_size) {
+  if (backdrop_fbo == 0) {
+    glGenRenderbuffers(1, &backdrop_color);
+    glBindRenderbuffer(GL_RENDERBUFFER, backdrop_color);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, info.samples, GL_RGBA8, fb_width, fb_height);
+    glGenRenderbuffers(1, &backdrop_depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, backdrop_depth);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, info.samples, GL_DEPTH_COMPONENT32F,
+                                     fb_width, fb_height);
+    glGenFramebuffers(1, &backdrop_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, backdrop_fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                              backdrop_color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              backdrop_depth);
+    const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      fail("Renderer: the " + std::to_string(info.samples) + "-sample backdrop framebuffer of " +
+           std::to_string(fb_width) + " x " + std::to_string(fb_height) +
+           " is incomplete (out of memory?): " + framebuffer_status_name(status));
+    }
+    check("allocating the backdrop framebuffer");
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, backdrop_fbo);
+  glViewport(0, 0, frame.width, frame.height);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (frame.ground) draw_ground(frame, view, projection, centre, half_size);
+  check("drawing the backdrop");
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, backdrop_fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
+  glBlitFramebuffer(0, 0, frame.width, frame.height, 0, 0, frame.width, frame.height,
+                    GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  read_back(whole(frame.width, frame.height), backdrop_rgb.data());
+  ms_dirty = whole(frame.width, frame.height);  // ms_fbo holds whatever was drawn before
+}
+
+// Reads `rect` of the resolved image back into `rgb` (the whole image's rows, top row first;
+// GL rows run bottom-up). RGBA is Mesa's fast read-back path (a plain copy); dropping alpha
+// here is cheaper than letting GL convert to RGB.
+void Renderer::Impl::read_back(const PixelRect& rect, std::uint8_t* rgb) {
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glReadPixels(rect.x0, rect.y0, rect.width(), rect.height(), GL_RGBA, GL_UNSIGNED_BYTE,
+               read_buffer.data());
+  check("reading back the image");
+  lap(&RenderPhases::read);
+  const std::size_t width = static_cast<std::size_t>(rect.width());
+  const std::size_t stride = 3 * static_cast<std::size_t>(fb_width);
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    const std::uint8_t* source = read_buffer.data() + 4 * width * static_cast<std::size_t>(y - rect.y0);
+    std::uint8_t* target = rgb + stride * static_cast<std::size_t>(fb_height - 1 - y) +
+                           3 * static_cast<std::size_t>(rect.x0);
+    for (std::size_t x = 0; x < width; ++x) {
+      target[3 * x] = source[4 * x];
+      target[3 * x + 1] = source[4 * x + 1];
+      target[3 * x + 2] = source[4 * x + 2];
+    }
+  }
+  lap(&RenderPhases::convert);
 }
 
 void Renderer::Impl::draw_lines(const Lines& lines) {
@@ -690,43 +889,80 @@ Image Renderer::Impl::render(const Frame& frame) {
   for (const Mesh& mesh : frame.meshes) {
     mesh_vertices.push_back(mesh.triangles.empty() ? std::vector<float>() : interleave(mesh));
   }
-  const std::size_t width = static_cast<std::size_t>(frame.width);
-  const std::size_t rows = static_cast<std::size_t>(frame.height);
-  read_buffer.resize(4 * width * rows);
+  const PixelRect all = whole(frame.width, frame.height);
+  const std::size_t pixels = static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height);
+  std::vector<float> key = backdrop_key_for(frame, view, projection, ground_centre, ground_half_size);
+  const bool over_backdrop = key == backdrop_key || key == direct_key;
+  const bool new_backdrop = over_backdrop && key != backdrop_key;
+  PixelRect drawn = all;
+  if (over_backdrop) {
+    float widest_line = 1;
+    for (const Lines& lines : frame.lines) {
+      widest_line = std::max(widest_line, std::clamp(lines.width, line_width_range[0], line_width_range[1]));
+    }
+    drawn = drawn_rect(frame, view, projection, widest_line);
+  }
+  read_buffer.resize(4 * pixels);
+  if (new_backdrop) backdrop_rgb.resize(3 * pixels);
   Image image;
   image.width = frame.width;
   image.height = frame.height;
-  image.rgb.resize(3 * width * rows);
+  if (over_backdrop && !new_backdrop) {
+    image.rgb = backdrop_rgb;  // the pixels outside `drawn`
+  } else {
+    image.rgb.resize(3 * pixels);
+  }
   lap(&RenderPhases::prepare);
 
   // Any failure from here on leaves the context in an unknown state (see `failure`).
   try {
     make_current();
     ensure_framebuffers(frame.width, frame.height);
-    glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
-    glViewport(0, 0, frame.width, frame.height);
     glClearColor(frame.background[0], frame.background[1], frame.background[2], 1.0f);
     glClearDepth(1.0);
     glDepthMask(GL_TRUE);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glBindVertexArray(vao);
+    if (over_backdrop) {
+      if (new_backdrop) {
+        build_backdrop(frame, view, projection, ground_centre, ground_half_size);
+        backdrop_key = std::move(key);
+        std::copy(backdrop_rgb.begin(), backdrop_rgb.end(), image.rgb.begin());
+        lap(&RenderPhases::backdrop);
+      }
+      // Back to the backdrop where the previous frame drew.
+      if (!ms_dirty.empty()) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, backdrop_fbo);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, ms_fbo);
+        glBlitFramebuffer(ms_dirty.x0, ms_dirty.y0, ms_dirty.x1, ms_dirty.y1, ms_dirty.x0,
+                          ms_dirty.y0, ms_dirty.x1, ms_dirty.y1,
+                          GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+        if (time_phases) glFinish();
+        lap(&RenderPhases::restore);
+      }
+      ms_dirty = drawn;
+      glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+      glViewport(0, 0, frame.width, frame.height);
+    } else {
+      glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
+      glViewport(0, 0, frame.width, frame.height);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      direct_key = std::move(key);
+      ms_dirty = all;
+    }
 
     glUseProgram(surface_program);
     glUniformMatrix4fv(surface_view, 1, GL_FALSE, view.data());
     glUniformMatrix4fv(surface_projection, 1, GL_FALSE, projection.data());
-    glUniform3fv(surface_background, 1, frame.background.data());
+    // Meshes are pushed slightly back so that coincident wireframe lines win the depth test.
     glEnable(GL_POLYGON_OFFSET_FILL);
-    // Meshes are pushed slightly back so that coincident wireframe lines win the depth test;
-    // the ground further still so that cloth lying on it stays visible.
     glPolygonOffset(1.0f, 1.0f);
     for (std::size_t i = 0; i < frame.meshes.size(); ++i) {
       draw_mesh(frame.meshes[i], mesh_vertices[i]);
     }
-    if (frame.ground) {
-      glPolygonOffset(4.0f, 16.0f);
-      draw_ground(frame, ground_centre, ground_half_size);
-    }
     glDisable(GL_POLYGON_OFFSET_FILL);
+    if (frame.ground && !over_backdrop) {
+      draw_ground(frame, view, projection, ground_centre, ground_half_size);
+    }
 
     if (!frame.lines.empty()) {
       glUseProgram(line_program);
@@ -741,33 +977,18 @@ Image Renderer::Impl::render(const Frame& frame) {
       lap(&RenderPhases::raster);
     }
 
-    // Resolve the samples, then read back (GL rows run bottom-up: flip to top row first).
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
-    glBlitFramebuffer(0, 0, frame.width, frame.height, 0, 0, frame.width, frame.height,
-                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    if (time_phases) {
-      glFinish();
-      lap(&RenderPhases::resolve);
-    }
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    // RGBA is Mesa's fast read-back path (a plain copy); dropping alpha here is cheaper than
-    // letting GL convert to RGB.
-    glReadPixels(0, 0, frame.width, frame.height, GL_RGBA, GL_UNSIGNED_BYTE, read_buffer.data());
-    check("reading back the image");
-    lap(&RenderPhases::read);
-
-    for (std::size_t y = 0; y < rows; ++y) {
-      const std::uint8_t* source = read_buffer.data() + 4 * width * (rows - 1 - y);
-      std::uint8_t* target = image.rgb.data() + 3 * width * y;
-      for (std::size_t x = 0; x < width; ++x) {
-        target[3 * x] = source[4 * x];
-        target[3 * x + 1] = source[4 * x + 1];
-        target[3 * x + 2] = source[4 * x + 2];
+    // Resolve the samples where the frame drew, then read them back.
+    if (!drawn.empty()) {
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, ms_fbo);
+      glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
+      glBlitFramebuffer(drawn.x0, drawn.y0, drawn.x1, drawn.y1, drawn.x0, drawn.y0, drawn.x1,
+                        drawn.y1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+      if (time_phases) {
+        glFinish();
+        lap(&RenderPhases::resolve);
       }
+      read_back(drawn, image.rgb.data());
     }
-    lap(&RenderPhases::convert);
   } catch (const std::exception& e) {
     if (failure.empty()) failure = e.what();
     throw;

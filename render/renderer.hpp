@@ -24,14 +24,18 @@ struct RendererInfo {
 // so that llvmpipe's deferred rasterisation is charged to the phase that queued it; the image is
 // the same with and without timing.
 struct RenderPhases {
-  double prepare = 0;  // validation, near/far planes, vertex data (normals when missing), buffers
-  double upload = 0;   // glBufferData of vertices and indices
-  double draw = 0;     // draw calls: vertex shading, clipping and binning (calling thread)
-  double raster = 0;   // glFinish after the draw calls: rasterisation and fragment shading
-  double resolve = 0;  // MSAA resolve (glBlitFramebuffer into the single-sample buffer, glFinish)
-  double read = 0;     // glReadPixels of the resolved image
-  double convert = 0;  // rows flipped to top first, RGBA to RGB
-  double total() const { return prepare + upload + draw + raster + resolve + read + convert; }
+  double prepare = 0;   // validation, near/far planes, vertex data (normals when missing), buffers
+  double backdrop = 0;  // drawing and resolving the backdrop (once per camera, see Renderer)
+  double restore = 0;   // the backdrop copied over what the previous frame drew (glFinish)
+  double upload = 0;    // glBufferData of vertices and indices
+  double draw = 0;      // draw calls: vertex shading, clipping and binning (calling thread)
+  double raster = 0;    // glFinish after the draw calls: rasterisation and fragment shading
+  double resolve = 0;   // MSAA resolve (glBlitFramebuffer into the single-sample buffer, glFinish)
+  double read = 0;      // glReadPixels of the resolved pixels
+  double convert = 0;   // rows flipped to top first, RGBA to RGB
+  double total() const {
+    return prepare + backdrop + restore + upload + draw + raster + resolve + read + convert;
+  }
 };
 
 // Owns one OSMesa context (created in the constructor, destroyed in the destructor). The
@@ -39,6 +43,12 @@ struct RenderPhases {
 // Renderer must be used from one thread at a time. Framebuffers are allocated on the first
 // render() and reallocated when the frame size changes. Not copyable; movable (a moved-from
 // Renderer may only be destroyed or assigned to).
+//
+// Frames in a row with the same size and background, and the same camera and ground if they
+// show the ground (an animation), are drawn over a kept backdrop: from the second such frame on, the background and ground are drawn
+// once, multisampled and resolved (an extra multisampled colour and depth buffer), and each
+// frame draws only its meshes and lines over them, and resolves and reads back only the
+// rectangle those can touch. The pixels are those of drawing the frame afresh.
 //
 // Failures. Input errors (std::invalid_argument) and running out of memory before the first GL
 // call of a frame (std::bad_alloc) leave the renderer usable. A failed GL or OSMesa call (a GL

@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -265,6 +266,75 @@ TEST(RendererTest, PhaseTimingReportsPhasesAndKeepsTheImage) {
     EXPECT_GE(phase, 0.0);
   EXPECT_GT(phases.total(), 0.0);
   EXPECT_GT(phases.raster + phases.resolve, 0.0);
+}
+
+// A frame of a small animation: the triangle raised by 1.2 and moved along x by `shift`, seen
+// from above the ground, optionally with its edges as a 3-pixel wireframe.
+Frame animation_frame(float shift, bool ground, bool wireframe) {
+  Frame frame;
+  Mesh mesh = front_triangle();
+  for (std::size_t i = 0; i < mesh.positions.size(); i += 3) {
+    mesh.positions[i] += shift;
+    mesh.positions[i + 1] += 1.2f;
+  }
+  if (wireframe) {
+    Lines edges;
+    edges.positions = mesh.positions;
+    edges.segments = {0, 1, 1, 2, 2, 0};
+    edges.width = 3;
+    frame.lines.push_back(edges);
+  }
+  frame.meshes.push_back(mesh);
+  frame.camera.eye = {0, 2.5f, 6};
+  frame.camera.target = {0, 1, 0};
+  frame.width = 160;
+  frame.height = 120;
+  frame.ground = ground;
+  return frame;
+}
+
+Image drawn_afresh(const Frame& frame) {
+  Renderer renderer(frame.width, frame.height);
+  return renderer.render(frame);
+}
+
+// One renderer drawing an animation draws its frames over a kept backdrop (background and
+// ground) and resolves only where their meshes and lines can be; each frame must still have
+// the pixels that a renderer of its own gives it: nothing of the previous frame left behind,
+// nothing cut off, also when the camera changes or a vertex lies behind the camera.
+TEST(RendererTest, AnimationFramesMatchFramesDrawnAfresh) {
+  for (const bool ground : {true, false}) {
+    for (const bool wireframe : {false, true}) {
+      SCOPED_TRACE(std::string(ground ? "ground" : "no ground") + (wireframe ? ", wireframe" : ""));
+      const Frame left = animation_frame(-1.6f, ground, wireframe);
+      const Frame right = animation_frame(1.6f, ground, wireframe);
+      Frame turned = left;  // another camera
+      turned.camera.eye = {1.5f, 2.0f, 5.5f};
+      Frame behind = left;  // a triangle reaching behind the camera: drawn and resolved whole
+      behind.meshes[0].positions[2] = 8;
+      Frame outside = left;  // nothing in the picture but the backdrop
+      for (std::size_t i = 0; i < outside.meshes[0].positions.size(); i += 3) outside.meshes[0].positions[i] += 40;
+      outside.lines.clear();
+      const std::vector<std::pair<const Frame*, Image>> expected = {
+          {&left, drawn_afresh(left)},     {&right, drawn_afresh(right)},
+          {&turned, drawn_afresh(turned)}, {&behind, drawn_afresh(behind)},
+          {&outside, drawn_afresh(outside)}};
+      ASSERT_NE(expected[0].second.rgb, expected[1].second.rgb);
+      auto reference = [&](const Frame* frame) -> const Image& {
+        for (const auto& [f, image] : expected) {
+          if (f == frame) return image;
+        }
+        throw std::logic_error("no reference image");
+      };
+      Renderer animated(160, 120);
+      const std::vector<const Frame*> sequence = {&left,   &left,   &right,   &right,   &left,
+                                                  &turned, &turned, &turned,  &left,    &left,
+                                                  &behind, &right,  &outside, &outside, &right};
+      for (std::size_t k = 0; k < sequence.size(); ++k) {
+        EXPECT_EQ(animated.render(*sequence[k]).rgb, reference(sequence[k]).rgb) << "frame " << k;
+      }
+    }
+  }
 }
 
 // The 12 triangles of the box [lo, hi], outward-facing.
