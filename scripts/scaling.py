@@ -3,11 +3,12 @@
 
 Usage:
   scaling.py run  --bin CLOTHSIM --csv OUT.csv [--label NAME] [--sizes 62x41,124x81,...]
-                  [--end 0.2] [--repeats 3] [--contact] [--set KEY=VALUE ...]
+                  [--end 0.2] [--repeats 3] [--contact] [--scene SCENE.json] [--set KEY=VALUE ...]
   scaling.py plot OUT.png A.csv [B.csv ...]     (one curve per label)
   scaling.py table A.csv [B.csv ...]            (Markdown table on stdout)
 
-`run` runs scenes/sleeve_compress_2542.json (dt = 0.01 s) with mesh.segments x mesh.rings
+`run` runs scenes/sleeve_compress_2542.json (dt = 0.01 s; --scene: another version of it, e.g. the
+file as it was at the commit an older binary was built from) with mesh.segments x mesh.rings
 replaced, to --end (default 0.2 s: 20 steps), without rendering or OBJ output and, unless
 --contact, without self-collision, each size --repeats times in separate processes, the sizes
 interleaved (size 1, 2, ..., then again), and appends one row per run to the CSV:
@@ -53,9 +54,9 @@ def parse_sizes(text):
     return sizes
 
 
-def one_run(binary, segments, rings, end, contact, extra_sets):
+def one_run(binary, scene, segments, rings, end, contact, extra_sets):
     with tempfile.TemporaryDirectory(prefix="clothsim_scaling_") as out:
-        command = [binary, SCENE, "--out", out, "--end", str(end), "--no-render",
+        command = [binary, scene, "--out", out, "--end", str(end), "--no-render",
                    "--set", "mesh.segments=%d" % segments, "--set", "mesh.rings=%d" % rings,
                    "--set", "output.obj=false", "--set", "collision.self=%s" % ("true" if contact else "false")]
         for s in extra_sets:
@@ -95,6 +96,7 @@ def vertices_of(segments, rings):
 
 def run(args):
     binary, out_csv, label, sizes, end, repeats, contact, sets = None, None, "run", DEFAULT_SIZES, 0.2, 3, False, []
+    scene = SCENE
     i = 0
     while i < len(args):
         a = args[i]
@@ -106,6 +108,7 @@ def run(args):
         elif a == "--end": end = float(value()); i += 2
         elif a == "--repeats": repeats = int(value()); i += 2
         elif a == "--set": sets.append(value()); i += 2
+        elif a == "--scene": scene = value(); i += 2
         elif a == "--contact": contact = True; i += 1
         else: die("unknown option " + a)
     if not binary or not out_csv:
@@ -117,7 +120,7 @@ def run(args):
             writer.writeheader()
         for repeat in range(repeats):
             for segments, rings in parse_sizes(sizes):
-                row = one_run(binary, segments, rings, end, contact, sets)
+                row = one_run(binary, scene, segments, rings, end, contact, sets)
                 row.update(label=label, repeat=repeat, vertices=vertices_of(segments, rings))
                 writer.writerow({k: (round(v, 4) if isinstance(v, float) else v) for k, v in row.items()})
                 f.flush()
