@@ -1,5 +1,6 @@
 // Reading and writing 8-bit RGB PNG files with libpng. Written files carry no timestamp or
-// text chunks, so equal images give byte-identical files.
+// text chunks, so equal images give byte-identical files (rows Paeth-filtered, run-length
+// deflated: fast to write, see png_io.cpp).
 #pragma once
 
 #include <string>
