@@ -9,6 +9,13 @@ packages=(
   python3-minimal python3-matplotlib python3-jsonschema
   clang libclang-rt-14-dev llvm  # scripts/sanitize.sh: clang 14, its sanitizer and libFuzzer run-times, llvm-symbolizer
 )
+# Optional: PETSc 3.18 (with hypre's BoomerAMG and ML) for bench/multilevel_bench's comparison with
+# those libraries' algebraic multigrid (docs/performance.md, "Multilevel preconditioners"); about
+# 110 packages with MPI, so only with CLOTHSIM_PETSC=1. Without it multilevel_bench builds without
+# the petsc: candidates.
+if [ "${CLOTHSIM_PETSC:-0}" = 1 ]; then
+  packages+=(libpetsc-real-dev)
+fi
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

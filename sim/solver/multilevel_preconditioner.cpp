@@ -146,7 +146,7 @@ struct Level {
   Csr p;                    // prolongation from the next coarser level
   Csr pt;                   // its transpose (restriction)
   // Work vectors of the cycle.
-  mutable Eigen::VectorXd x, b, r, d, w;
+  mutable Eigen::VectorXd x, b, r, d, w, t;
 
   Index size() const { return a.rows(); }
   int nodes() const { return static_cast<int>(node_start.size()) - 1; }
@@ -211,8 +211,7 @@ double estimate_lambda_max(const Level& level, int iterations) {
     v /= v.norm();
     multiply(level.a, v, av);
     level.block_solve(av, w);
-    // Rayleigh quotient of the pencil (A, D): vᵀAv / vᵀDv, with D v recovered as D (D⁻¹ A v)... use
-    // the ratio of norms of successive iterates in the D-norm instead: λ ≈ |w| / |v|.
+    // |D⁻¹A v| for |v| = 1: tends to λ_max (D⁻¹A is similar to the symmetric D^-½ A D^-½).
     lambda = w.norm();
     v = w;
   }
@@ -314,22 +313,26 @@ MultilevelSettings parse_multilevel_settings(const std::string& text) {
     const auto eq = item.find('=');
     if (eq == std::string::npos) throw std::invalid_argument("multilevel settings: expected key=value, got " + item);
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    double number = 0.0;
     try {
-      if (key == "near_null_space") s.near_null_space = std::stoi(value);
-      else if (key == "threshold") s.threshold = std::stod(value);
-      else if (key == "prolongation_smoothing") s.prolongation_smoothing = std::stoi(value);
-      else if (key == "prolongation_omega") s.prolongation_omega = std::stod(value);
-      else if (key == "coarse_size") s.coarse_size = std::stoi(value);
-      else if (key == "max_levels") s.max_levels = std::stoi(value);
-      else if (key == "smoothing_steps") s.smoothing_steps = std::stoi(value);
-      else if (key == "chebyshev_ratio") s.chebyshev_ratio = std::stod(value);
-      else if (key == "cycle") s.cycle = std::stoi(value);
-      else if (key == "power_iterations") s.power_iterations = std::stoi(value);
-      else throw std::invalid_argument("multilevel settings: unknown key " + key);
-    } catch (const std::logic_error& e) {
-      if (dynamic_cast<const std::invalid_argument*>(&e) && std::string(e.what()).find("multilevel") == 0) throw;
-      throw std::invalid_argument("multilevel settings: bad value in " + item);
+      std::size_t used = 0;
+      number = std::stod(value, &used);
+      if (used != value.size()) throw std::invalid_argument(value);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("multilevel settings: " + key + " needs a number, got " + value);
     }
+    const int integer = static_cast<int>(number);
+    if (key == "near_null_space") s.near_null_space = integer;
+    else if (key == "threshold") s.threshold = number;
+    else if (key == "prolongation_smoothing") s.prolongation_smoothing = integer;
+    else if (key == "prolongation_omega") s.prolongation_omega = number;
+    else if (key == "coarse_size") s.coarse_size = integer;
+    else if (key == "max_levels") s.max_levels = integer;
+    else if (key == "smoothing_steps") s.smoothing_steps = integer;
+    else if (key == "chebyshev_ratio") s.chebyshev_ratio = number;
+    else if (key == "cycle") s.cycle = integer;
+    else if (key == "power_iterations") s.power_iterations = integer;
+    else throw std::invalid_argument("multilevel settings: unknown key " + key);
   }
   return s;
 }
@@ -376,6 +379,8 @@ void MultilevelPreconditioner::Impl::smooth(const Level& l, const Eigen::VectorX
   }
 }
 
+// One cycle on level k from a zero start: pre-smoothing, coarse correction (twice per level for
+// a W-cycle), post-smoothing. Uses the levels' work vectors only.
 void MultilevelPreconditioner::Impl::cycle(std::size_t k, const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
   const Level& l = levels[k];
   if (k + 1 == levels.size()) {
@@ -384,16 +389,14 @@ void MultilevelPreconditioner::Impl::cycle(std::size_t k, const Eigen::VectorXd&
   }
   const Level& c = levels[k + 1];
   smooth(l, b, x, true);
-  for (int repeat = 0; repeat < (k + 2 == levels.size() ? 1 : settings.cycle); ++repeat) {
-    Eigen::VectorXd r;
-    residual(l.a, b, x, r);
-    Eigen::VectorXd bc, xc;
-    multiply(l.pt, r, bc);
-    cycle(k + 1, bc, xc);
-    multiply(l.p, xc, r);
-    x += r;
+  const int corrections = k + 2 == levels.size() ? 1 : settings.cycle;  // the coarsest solve is exact
+  for (int repeat = 0; repeat < corrections; ++repeat) {
+    residual(l.a, b, x, l.t);
+    multiply(l.pt, l.t, c.b);
+    cycle(k + 1, c.b, c.x);
+    multiply(l.p, c.x, l.t);
+    x += l.t;
   }
-  (void)c;
   smooth(l, b, x, false);
 }
 
@@ -508,29 +511,8 @@ bool MultilevelPreconditioner::setup(const Eigen::SparseMatrix<double>& a, const
       std::vector<int> rows;
       for (int node : members[static_cast<std::size_t>(g)])
         for (int i = l.node_start[static_cast<std::size_t>(node)]; i < l.node_start[static_cast<std::size_t>(node) + 1]; ++i) rows.push_back(i);
-      // On level 0 with quadratic modes: the global modes and, about the aggregate's centroid,
-      // the nine fields δ_b (e_a × δ) (rotations varying linearly: local bending).
-      const bool quadratic = m.levels.size() == 1 && rotations && s.near_null_space > 6;
-      Eigen::MatrixXd local(static_cast<Index>(rows.size()), k_modes + (quadratic ? 9 : 0));
-      for (std::size_t i = 0; i < rows.size(); ++i) local.row(static_cast<Index>(i)).head(k_modes) = b.row(rows[i]);
-      if (quadratic) {
-        Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-        for (int row : rows) centre += positions.segment<3>(3 * (m.free_rows[static_cast<std::size_t>(row)] / 3));
-        centre /= static_cast<double>(rows.size());
-        double radius = 1e-300;
-        for (int row : rows)
-          radius = std::max(radius, (positions.segment<3>(3 * (m.free_rows[static_cast<std::size_t>(row)] / 3)) - centre).norm());
-        for (std::size_t i = 0; i < rows.size(); ++i) {
-          const int full = m.free_rows[static_cast<std::size_t>(rows[i])];
-          const Eigen::Vector3d d = (positions.segment<3>(3 * (full / 3)) - centre) / radius;
-          for (int aa = 0; aa < 3; ++aa)
-            for (int bb = 0; bb < 3; ++bb) {
-              Eigen::Vector3d e = Eigen::Vector3d::Zero();
-              e[aa] = 1.0;
-              local(static_cast<Index>(i), k_modes + 3 * aa + bb) = d[bb] * e.cross(d)[full % 3];
-            }
-        }
-      }
+      Eigen::MatrixXd local(static_cast<Index>(rows.size()), k_modes);
+      for (std::size_t i = 0; i < rows.size(); ++i) local.row(static_cast<Index>(i)) = b.row(rows[i]);
       Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(local);
       qr.setThreshold(1e-10);
       const int rank = static_cast<int>(qr.rank());
@@ -541,7 +523,7 @@ bool MultilevelPreconditioner::setup(const Eigen::SparseMatrix<double>& a, const
       for (std::size_t i = 0; i < rows.size(); ++i)
         for (int j = 0; j < rank; ++j) t.emplace_back(rows[i], c0 + j, q(static_cast<Index>(i), j));
       coarse_start.push_back(c0 + rank);
-      coarse_b.push_back(rb.leftCols(k_modes));  // the global modes on the coarse level
+      coarse_b.push_back(rb);
     }
     const Index nc = coarse_start.back();
     Csr p(l.size(), nc);
@@ -600,13 +582,13 @@ bool MultilevelPreconditioner::refresh(const Eigen::SparseMatrix<double>& a, boo
 
 void MultilevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) const {
   const Impl& m = *impl_;
+  if (!m.ready) throw std::logic_error("MultilevelPreconditioner::apply before a successful set-up");
   const Level& l = m.levels.front();
   l.b.resize(l.size());
   for (Index i = 0; i < l.size(); ++i) l.b[i] = r[m.free_rows[static_cast<std::size_t>(i)]];
-  Eigen::VectorXd x;
-  m.cycle(0, l.b, x);
+  m.cycle(0, l.b, l.x);
   z.setZero(r.size());
-  for (Index i = 0; i < l.size(); ++i) z[m.free_rows[static_cast<std::size_t>(i)]] = x[i];
+  for (Index i = 0; i < l.size(); ++i) z[m.free_rows[static_cast<std::size_t>(i)]] = l.x[i];
 }
 
 int MultilevelPreconditioner::levels() const { return static_cast<int>(impl_->levels.size()); }
