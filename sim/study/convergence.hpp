@@ -119,12 +119,6 @@ struct SleeveMesh {
   int rings = 0;
 };
 
-// One setting of a sleeve's tolerance series: a method at a time step (on the case's tolerance_mesh).
-struct ToleranceSetting {
-  std::string method;  // Method::name; a setting whose method is not in the study is skipped
-  double dt = 1e-3;    // [s]
-};
-
 struct PlateStudyCase {
   AnalyticPlate plate;
   std::vector<int> divisions;  // grids of n × n cells, coarse to fine
@@ -134,6 +128,13 @@ struct PlateStudyCase {
 struct ErrorWindow {
   std::string name;           // the CSV's "window" column, e.g. "early"
   std::vector<double> times;  // [s], positive and increasing
+};
+
+// One setting of a sleeve's tolerance series: a method on a mesh at a time step.
+struct ToleranceSetting {
+  std::string method;  // Method::name; a setting whose method is not in the study is skipped
+  SleeveMesh mesh;
+  double dt = 1e-3;    // [s]
 };
 
 struct SleeveStudyCase {
@@ -151,15 +152,14 @@ struct SleeveStudyCase {
   // Methods that also run the time-step series (the others run the mesh series only); empty: all.
   std::vector<std::string> dt_series_methods;
   // Tolerance series (the linear solver's relative-residual tolerance, the scene's
-  // solver.tolerance): each of tolerance_settings (a method at a time step) on tolerance_mesh, once
-  // with every tolerance of `tolerances` and once with tight_tolerance, the solver reference of
-  // that setting (its solver error is 0 by definition). Each run's error is reported against the
+  // solver.tolerance): each of tolerance_settings (a method on a mesh at a time step), once with
+  // every tolerance of `tolerances` and once with tight_tolerance, the solver reference of that
+  // setting (its solver error is 0 by definition). Each run's error is reported against the
   // study's reference (total error), against the tight run of its setting (solver error), and the
   // tight run's against the reference (discretisation error). Empty `tolerances`: no tolerance
   // series.
   std::vector<double> tolerances;  // loose to tight, each > tight_tolerance
   double tight_tolerance = 1e-12;
-  SleeveMesh tolerance_mesh;
   std::vector<ToleranceSetting> tolerance_settings;
   SleeveMesh reference_mesh;       // the reference run: this mesh, reference_dt, reference_method
   double reference_dt = 5e-4;      // [s]
