@@ -18,8 +18,8 @@ iterations per step (dashed, right axis) against the tolerance. Colour
 style = plate case (plates panel) or series and error window (dynamic panels: solid = mesh
 refinement at a fixed time step, dashed = time-step refinement on the reference mesh, both with
 filled markers for the first window; dotted and dash-dotted with hollow markers for later
-windows; in the tolerance panels the marker gives the time step). Plates: thin grey lines mark the
-relative precision of each published coefficient. Rows of the "reference" series, failed runs
+windows; in the tolerance panels the marker gives the mesh and time step). Plates: thin grey
+lines mark the relative precision of each published coefficient. Rows of the "reference" series, failed runs
 (error nan) and errors of exactly 0 cannot be drawn on a log axis and are left out; the tolerance
 series appears only in its own panels. Exits with status 3 when matplotlib is missing (Debian:
 python3-matplotlib).
@@ -200,7 +200,7 @@ def draw_fold_panel(ax, rows, case, colour):
         ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
 
 
-TOLERANCE_MARKERS = ["o", "s", "^", "D"]  # by time step, in file order
+TOLERANCE_MARKERS = ["o", "s", "^", "D", "v"]  # by mesh and time step, in file order
 
 
 def tolerance_rows(rows, case):
@@ -212,18 +212,20 @@ def has_tolerance_series(rows, case):
     return bool(tolerance_rows(rows, case))
 
 
+def base_setting(row):
+    """The setting without its tolerance: '26x19 dt=0.001'."""
+    return row["setting"].split(" tol=")[0]
+
+
 def tolerance_settings(rows, case):
-    """(method, dt) -> marker, in file order."""
-    dts, markers = [], {}
+    """(method, mesh and time step) -> marker, in file order."""
+    bases, markers = [], {}
     for r in tolerance_rows(rows, case):
-        if r["dt"] not in dts:
-            dts.append(r["dt"])
-        markers.setdefault((r["method"], r["dt"]), TOLERANCE_MARKERS[dts.index(r["dt"]) % len(TOLERANCE_MARKERS)])
+        base = base_setting(r)
+        if base not in bases:
+            bases.append(base)
+        markers.setdefault((r["method"], base), TOLERANCE_MARKERS[bases.index(base) % len(TOLERANCE_MARKERS)])
     return markers
-
-
-def dt_label(dt):
-    return f"dt = {float(dt) * 1e3:g} ms"
 
 
 def draw_tolerance_error_panel(ax, rows, case, colour):
@@ -236,20 +238,20 @@ def draw_tolerance_error_panel(ax, rows, case, colour):
             windows.append(r["window"])
     curves, levels = {}, {}
     for r in tolerance_rows(rows, case):
-        key = (r["method"], r["dt"], r["window"])
+        key = (r["method"], base_setting(r), r["window"])
         error = number(r, "solver_error")
         if error is not None and error > 0:
             curves.setdefault(key, []).append((number(r, "tolerance"), error))
         level = number(r, "discretization_error")
         if level is not None and level > 0:
             levels[key] = level
-    for (method, dt, window), points in curves.items():
+    for (method, base, window), points in curves.items():
         first = window == windows[0]
         points.sort()
         ax.plot([p[0] for p in points], [p[1] for p in points], linestyle="-" if first else ":",
-                marker=markers[(method, dt)], color=colour[method], markersize=5,
+                marker=markers[(method, base)], color=colour[method], markersize=5,
                 markerfacecolor=colour[method] if first else "white")
-    for (method, dt, window), level in levels.items():
+    for (method, base, window), level in levels.items():
         ax.axhline(level, color=colour[method], linestyle="-" if window == windows[0] else ":", linewidth=0.9,
                    alpha=0.55, zorder=0)
     ax.set_xscale("log")
@@ -259,8 +261,8 @@ def draw_tolerance_error_panel(ax, rows, case, colour):
     ax.set_title(f"{case}: solver error against tolerance (thin lines: discretisation error)", fontsize=10)
     ax.grid(True, which="major", alpha=0.4)
     ax.grid(True, which="minor", alpha=0.12)
-    handles = [plt.Line2D([], [], color=colour[method], linestyle="", marker=m, label=f"{method} · {dt_label(dt)}")
-               for (method, dt), m in markers.items()]
+    handles = [plt.Line2D([], [], color=colour[method], linestyle="", marker=m, label=f"{method} · {base}")
+               for (method, base), m in markers.items()]
     handles += [plt.Line2D([], [], color="0.3", linestyle="-" if w == windows[0] else ":",
                            markerfacecolor="0.3" if w == windows[0] else "white", marker="o", label=f"window {w}")
                 for w in windows]
@@ -283,14 +285,14 @@ def draw_tolerance_cost_panel(ax, rows, case, colour):
         seconds, iterations, steps = number(r, "wall_seconds"), number(r, "solver_iterations"), number(r, "steps")
         if seconds is None or seconds <= 0 or not steps:
             continue
-        curves.setdefault((r["method"], r["dt"]), []).append((number(r, "tolerance"), seconds, iterations / steps))
+        curves.setdefault((r["method"], base_setting(r)), []).append((number(r, "tolerance"), seconds, iterations / steps))
     right = ax.twinx()
-    for (method, dt), points in curves.items():
+    for (method, base), points in curves.items():
         points.sort()
         x = [p[0] for p in points]
-        ax.plot(x, [p[1] for p in points], linestyle="-", marker=markers[(method, dt)], color=colour[method],
+        ax.plot(x, [p[1] for p in points], linestyle="-", marker=markers[(method, base)], color=colour[method],
                 markersize=5)
-        right.plot(x, [p[2] for p in points], linestyle="--", marker=markers[(method, dt)], color=colour[method],
+        right.plot(x, [p[2] for p in points], linestyle="--", marker=markers[(method, base)], color=colour[method],
                    markersize=4, markerfacecolor="white")
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -300,8 +302,8 @@ def draw_tolerance_cost_panel(ax, rows, case, colour):
     right.set_ylim(bottom=0)
     ax.set_title(f"{case}: cost against tolerance", fontsize=10)
     ax.grid(True, which="major", alpha=0.4)
-    handles = [plt.Line2D([], [], color=colour[method], linestyle="", marker=m, label=f"{method} · {dt_label(dt)}")
-               for (method, dt), m in markers.items()]
+    handles = [plt.Line2D([], [], color=colour[method], linestyle="", marker=m, label=f"{method} · {base}")
+               for (method, base), m in markers.items()]
     ax.legend(handles=handles, fontsize=6.5, loc="best")
     if not curves:
         ax.text(0.5, 0.5, "no drawable rows", transform=ax.transAxes, ha="center")
