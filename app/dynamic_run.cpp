@@ -1,7 +1,9 @@
 // The dynamic part of the clothsim command: builds the Simulator, then steps it while streaming
-// probes.csv, stats.csv, OBJ frames and (with motion framing) PNG frames (flushed every step, so a
-// failed or interrupted run keeps what it has written) and finally summary.json (replaced
-// atomically). The Simulator is used in this file only.
+// probes.csv, stats.csv, OBJ frames (flushed every step, so a failed or interrupted run keeps what
+// it has written) and, with motion framing, PNG frames (drawn on FrameImages' drawing thread while
+// the next steps are computed; every picture handed in is on disk before a checkpoint or the
+// summary is written) and finally summary.json (replaced atomically). The Simulator is used in
+// this file only.
 #include "app/dynamic_run.hpp"
 
 #include "app/checkpoint.hpp"
@@ -275,8 +277,8 @@ class Outputs {
         }
       }
       if (images_) {
-        if (repeated) images_->repeat();
-        else images_->add(sim.state().x, sim.state().t);
+        if (repeated) images_->repeat(step);
+        else images_->add(sim.state().x, sim.state().t, step);
       }
       repeated = true;
       ++totals.frames;
@@ -386,6 +388,22 @@ class InterruptHandlers {
  private:
   struct sigaction old_int_ {}, old_term_ {};
 };
+
+// Motion framing draws its pictures on a thread of their own while the simulation goes on
+// (FrameImages); CLOTHSIM_RENDER_THREAD=0 draws them on the simulating thread instead, as each
+// frame comes (the same bytes; for tests and for comparing).
+bool drawing_thread() {
+  const char* setting = std::getenv("CLOTHSIM_RENDER_THREAD");
+  return setting == nullptr || std::string(setting) != "0";
+}
+
+// A frame's picture that failed, reported like any failure in a step, "step N (t = ...): ...",
+// with the step whose state the frame showed (the drawing thread may report it a frame or two
+// later); the picture of the initial state, drawn before the first step: the message alone.
+[[noreturn]] void throw_picture_failure(const FramePictureError& e, double dt) {
+  if (e.step() == 0) throw std::runtime_error(e.what());
+  throw SimulationError(e.step(), e.step() * dt, e.what());
+}
 
 // DIR/<name>.mp4 from frame_%04d.png with ffmpeg, if it is installed (a warning otherwise).
 void encode_video(const fs::path& dir, const std::string& name, double fps) {
@@ -589,7 +607,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
           r.state_size = sim->state().x.size();
         }
         images = std::make_unique<FrameImages>(*drawer, *renderer, scene.render.framing, motion_bounds, dir,
-                                               resume ? &r : nullptr);
+                                               resume ? &r : nullptr, drawing_thread());
       }
       outputs = std::make_unique<Outputs>(scene, dir, images.get(), resume.has_value());
       if (!resume) outputs->record_state(*sim, 0, sim->state().t, totals);
@@ -622,12 +640,22 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
           if (checkpoint_due || interrupted != 0) write_run_checkpoint();
         } catch (const SimulationError&) {
           throw;
+        } catch (const FramePictureError& e) {
+          throw_picture_failure(e, scene.problem.time.dt);  // possibly a frame of an earlier step
         } catch (const std::exception& e) {
           // Name the step for any other failure (write errors, solver exceptions), as SimulationError does.
           throw SimulationError(k, k * scene.problem.time.dt, e.what());
         }
         progress.update(k, totals.t, totals.frames, wall() - wall_before);
         if (interrupted != 0) break;
+      }
+      // Motion framing: the last pictures on disk before the summary says what was written.
+      if (images) {
+        try {
+          images->drain();
+        } catch (const FramePictureError& e) {
+          throw_picture_failure(e, scene.problem.time.dt);
+        }
       }
     } catch (const std::exception& e) {
       failure = e.what();

@@ -1,9 +1,12 @@
-// The pictures of a dynamic run: drawn one frame at a time as the frames come (motion framing)
-// or after the run from a spool file of control-net positions (sequence framing).
+// The pictures of a dynamic run: drawn one frame at a time as the frames come (motion framing,
+// on a drawing thread while the simulation goes on, or on the caller's) or after the run from a
+// spool file of control-net positions (sequence framing).
 #include "app/frame_images.hpp"
 
 #include "render/png_io.hpp"
 #include "sim/boundary/motion.hpp"
+
+#include <signal.h>
 
 #include <algorithm>
 #include <cmath>
@@ -74,7 +77,7 @@ Bounds motion_framing_bounds(const LimitSurfaceDrawer& drawer, const Eigen::Vect
 fs::path frame_spool_path(const fs::path& dir) { return dir / ".frames.bin"; }
 
 FrameImages::FrameImages(const LimitSurfaceDrawer& drawer, render::Renderer& renderer, Framing framing,
-                         const Bounds& motion_bounds, fs::path dir, const FrameResume* resume)
+                         const Bounds& motion_bounds, fs::path dir, const FrameResume* resume, bool asynchronous)
     : drawer_(drawer), renderer_(renderer), framing_(framing), dir_(std::move(dir)) {
   if (resume) {
     frames_ = resume->frames;
@@ -83,6 +86,11 @@ FrameImages::FrameImages(const LimitSurfaceDrawer& drawer, render::Renderer& ren
   if (framing_ == Framing::motion) {
     bounds_ = motion_bounds;
     camera_ = drawer_.camera(bounds_.lo, bounds_.hi);
+    if (asynchronous) {
+      renderer_.release_context();  // the drawing thread makes it current on itself
+      asynchronous_ = true;
+      drawing_ = std::thread(&FrameImages::draw_pictures, this);
+    }
   } else {
     const fs::path path = frame_spool_path(dir_);
     if (resume) {
@@ -112,9 +120,13 @@ FrameImages::FrameImages(const LimitSurfaceDrawer& drawer, render::Renderer& ren
 }
 
 FrameResume FrameImages::resume_point() {
+  drain();  // a checkpoint counts only pictures that are on disk
   FrameResume r;
   r.frames = frames_;
-  r.written = written_;
+  {
+    std::lock_guard lock(mutex_);
+    r.written = written_;
+  }
   r.bounds = bounds_;
   if (framing_ == Framing::sequence && spool_.is_open()) {
     spool_.flush();
@@ -125,6 +137,7 @@ FrameResume FrameImages::resume_point() {
 }
 
 FrameImages::~FrameImages() {
+  stop_drawing();
   if (framing_ != Framing::sequence || keep_spool_) return;
   spool_.close();
   std::error_code ec;
@@ -141,10 +154,16 @@ void FrameImages::spool(const Eigen::VectorXd& x, double t) {
   if (!spool_) throw std::runtime_error(frame_spool_path(dir_).string() + ": cannot write the file");
 }
 
-void FrameImages::add(const Eigen::VectorXd& x, double t) {
-  if (framing_ == Framing::motion) {
-    last_image_ = renderer_.render(drawer_.frame(drawer_.snapshot(x, t), camera_, bounds_.lo[1]));
-    write_picture(*last_image_, frames_);
+void FrameImages::add(const Eigen::VectorXd& x, double t, int step) {
+  if (framing_ == Framing::motion && asynchronous_) {
+    hand_over(Job{frames_, step, false, drawer_.snapshot(x, t)});
+  } else if (framing_ == Framing::motion) {
+    try {
+      last_image_ = renderer_.render(drawer_.frame(drawer_.snapshot(x, t), camera_, bounds_.lo[1]));
+      write_picture(*last_image_, frames_);
+    } catch (const std::exception& e) {
+      throw FramePictureError(e.what(), step);
+    }
     ++written_;
   } else {
     LimitSurfaceDrawer::extend_bounds(drawer_.snapshot(x, t), bounds_.lo, bounds_.hi);
@@ -155,10 +174,16 @@ void FrameImages::add(const Eigen::VectorXd& x, double t) {
   ++frames_;
 }
 
-void FrameImages::repeat() {
+void FrameImages::repeat(int step) {
   if (frames_ == 0) throw std::logic_error("FrameImages::repeat: no frame to repeat");
-  if (framing_ == Framing::motion) {
-    write_picture(*last_image_, frames_);
+  if (framing_ == Framing::motion && asynchronous_) {
+    hand_over(Job{frames_, step, true, {}});
+  } else if (framing_ == Framing::motion) {
+    try {
+      write_picture(*last_image_, frames_);
+    } catch (const std::exception& e) {
+      throw FramePictureError(e.what(), step);
+    }
     ++written_;
   } else {
     spool(last_positions_, last_time_);
@@ -166,8 +191,88 @@ void FrameImages::repeat() {
   ++frames_;
 }
 
+void FrameImages::hand_over(Job job) {
+  {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return pending_ < kMaxPendingPictures || error_.has_value(); });
+    if (error_) {
+      error_reported_ = true;
+      throw *error_;
+    }
+    queue_.push_back(std::move(job));
+    ++pending_;
+  }
+  changed_.notify_all();
+}
+
+void FrameImages::drain() {
+  if (!asynchronous_) return;
+  std::unique_lock lock(mutex_);
+  changed_.wait(lock, [&] { return pending_ == 0 || error_.has_value(); });
+  // Reported once, like a failure on the simulating thread (finish() after it returns).
+  if (error_ && !error_reported_) {
+    error_reported_ = true;
+    throw *error_;
+  }
+}
+
+void FrameImages::draw_pictures() {
+  // Interrupts are the simulating thread's business (it stops after the current step).
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  for (;;) {
+    Job job;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [&] { return !queue_.empty() || stopping_; });
+      if (queue_.empty()) break;
+      job = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    try {
+      if (!job.repeat) drawn_last_ = renderer_.render(drawer_.frame(job.surface, camera_, bounds_.lo[1]));
+      job.surface = SurfaceSnapshot{};
+      write_picture(drawn_last_, job.frame);
+      std::lock_guard lock(mutex_);
+      ++written_;
+      --pending_;
+    } catch (const std::exception& e) {
+      // As on the simulating thread: the run stops at this picture; the later ones are dropped.
+      std::lock_guard lock(mutex_);
+      error_.emplace(e.what(), job.step);
+      queue_.clear();
+      pending_ = 0;
+    } catch (...) {
+      std::lock_guard lock(mutex_);
+      error_.emplace("drawing frame " + std::to_string(job.frame) + " failed", job.step);
+      queue_.clear();
+      pending_ = 0;
+    }
+    changed_.notify_all();
+  }
+  renderer_.release_context();
+}
+
+void FrameImages::stop_drawing() noexcept {
+  if (!drawing_.joinable()) return;
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+  drawing_.join();
+}
+
 int FrameImages::finish(bool keep_spool) {
-  if (framing_ != Framing::sequence || !spool_.is_open()) return written_;
+  if (framing_ == Framing::motion) {
+    drain();
+    std::lock_guard lock(mutex_);
+    return written_;
+  }
+  if (!spool_.is_open()) return written_;
   keep_spool_ = keep_spool;
   const fs::path path = frame_spool_path(dir_);
   spool_.close();

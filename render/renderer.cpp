@@ -1010,6 +1010,11 @@ Image Renderer::render(const Frame& frame) {
   return impl_->render(frame);
 }
 
+void Renderer::release_context() {
+  if (!impl_ || impl_->context == nullptr || !impl_->failure.empty()) return;
+  if (OSMesaGetCurrentContext() == impl_->context) OSMesaMakeCurrent(nullptr, nullptr, 0, 0, 0);
+}
+
 const RendererInfo& Renderer::info() const { return impl_->info; }
 void Renderer::set_phase_timing(bool on) { impl_->time_phases = on; }
 const RenderPhases& Renderer::last_phases() const { return impl_->phases; }

@@ -40,7 +40,8 @@ struct RenderPhases {
 
 // Owns one OSMesa context (created in the constructor, destroyed in the destructor). The
 // context is made current on the calling thread by the constructor and by every render(); a
-// Renderer must be used from one thread at a time. Framebuffers are allocated on the first
+// Renderer must be used from one thread at a time, and a thread that is done with it before
+// another takes over calls release_context(). Framebuffers are allocated on the first
 // render() and reallocated when the frame size changes. Not copyable; movable (a moved-from
 // Renderer may only be destroyed or assigned to).
 //
@@ -74,6 +75,11 @@ class Renderer {
   // an inconsistent frame (sizes out of range, index out of bounds, degenerate camera) and
   // std::runtime_error if GL reports an error.
   Image render(const Frame& frame);
+
+  // Leaves the calling thread without a current context if this renderer's is current on it
+  // (another thread can then render with it). Not after a failure (see above): a failed context
+  // is never made current or released again. The next render() makes it current again.
+  void release_context();
 
   const RendererInfo& info() const;
   // Phase timing of render() (off by default; for benchmarks): see RenderPhases.

@@ -1,8 +1,11 @@
 // The PNG frames of dynamic runs, through the built clothsim binary: with the default framing
-// ("motion") each frame's picture is on disk as soon as the frame is produced, so a run killed
-// part-way keeps whole pictures of its first frames, and the camera fixed before the run keeps
-// the cloth in the picture; framing "sequence" (scene key or --framing) draws after the run and
-// leaves no spool file behind; a bad render.framing is an input error that writes nothing.
+// ("motion") each frame's picture is drawn while the simulation goes on (on a drawing thread, at
+// most two frames behind; CLOTHSIM_RENDER_THREAD=0 draws on the simulating thread) and gives the
+// same bytes either way, a run killed part-way keeps whole pictures of its first frames, a picture
+// that cannot be written fails the run as it did when drawn inline, and the camera fixed before
+// the run keeps the cloth in the picture; framing "sequence" (scene key or --framing) draws after
+// the run and leaves no spool file behind; a bad render.framing is an input error that writes
+// nothing.
 #include "render/image.hpp"
 #include "render/png_io.hpp"
 
@@ -23,6 +26,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
@@ -157,10 +161,11 @@ class FrameImagesTest : public ::testing::Test {
     return path;
   }
 
-  // Runs `clothsim SCENE --out OUT <args>` with stdout and stderr captured.
-  RunResult run(const fs::path& scene, const std::string& args = "") const {
+  // Runs `clothsim SCENE --out OUT <args>` with stdout and stderr captured; `environment`:
+  // assignments put in front of the command.
+  RunResult run(const fs::path& scene, const std::string& args = "", const std::string& environment = "") const {
     const fs::path err_file = dir_ / "stderr.txt";
-    const std::string command = shell_quote(CLOTHSIM_BINARY) + " " + shell_quote(scene.string()) + " --out " +
+    const std::string command = environment + " " + shell_quote(CLOTHSIM_BINARY) + " " + shell_quote(scene.string()) + " --out " +
                                 shell_quote(out_.string()) + " " + args + " >/dev/null 2>" +
                                 shell_quote(err_file.string());
     const int status = std::system(command.c_str());
@@ -218,6 +223,113 @@ TEST_F(FrameImagesTest, KilledRunKeepsTheFramesWrittenSoFar) {
     EXPECT_EQ(image.width, 160) << file;
     EXPECT_EQ(image.height, 120) << file;
     EXPECT_GT(non_background_pixels(image), 100) << file;  // the cloth is in the picture
+  }
+}
+
+// Every file of a run folder but summary.json and stats.csv (wall times), by name.
+std::map<std::string, std::string> run_files(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    const std::string name = fs::relative(e.path(), dir).string();
+    if (e.is_regular_file() && name != "summary.json" && name != "stats.csv") files[name] = read_file_bytes(e.path());
+  }
+  return files;
+}
+
+TEST_F(FrameImagesTest, DrawingThreadWritesTheBytesOfDrawingOnTheSimulatingThread) {
+  // 320 x 240 with a ground, steps of 2 ms and frames every 1 ms (every other picture repeats
+  // the previous one), and a checkpoint every 7 frames (which waits for the pictures): drawing
+  // takes longer than a step, so the drawing thread falls behind and the run waits for it.
+  std::string text = falling_cloth(R"("ground": true)");
+  const std::string time = R"("time": {"dt": 0.001, "end": 0.01, "output_fps": 500})";
+  text.replace(text.find(time), time.size(),
+               R"("time": {"dt": 0.002, "end": 0.05, "output_fps": 1000}, "output": {"checkpoint_every": 7})");
+  const fs::path scene = write("steps.json", text);
+  RunResult r = run(scene, "--size 320x240");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::map<std::string, std::string> threaded = run_files(out_ / "cloth");
+  r = run(scene, "--size 320x240", "CLOTHSIM_RENDER_THREAD=0");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::map<std::string, std::string> inline_drawn = run_files(out_ / "cloth");
+  ASSERT_EQ(frame_files(out_ / "cloth").size(), 51u);  // t = 0, 1, ..., 50 ms
+  ASSERT_EQ(threaded.size(), inline_drawn.size());
+  for (const auto& [name, bytes] : inline_drawn) {
+    const auto other = threaded.find(name);
+    ASSERT_NE(other, threaded.end()) << name << " is missing from the run with the drawing thread";
+    EXPECT_TRUE(other->second == bytes) << name << " differs";
+  }
+  EXPECT_EQ(threaded.at("frame_0001.png"), threaded.at("frame_0002.png"));  // a repeated frame
+  EXPECT_NE(threaded.at("frame_0002.png"), threaded.at("frame_0003.png"));
+}
+
+// A picture that cannot be written (a folder stands where frame N's PNG goes: the rename onto
+// it fails) ends the run as on the simulating thread: the error names the step of frame N and
+// the file, the exit code is 1, summary.json says "failed", frames 0 .. N-1 are all there and
+// whole, nothing after N, no temporary file. The folder is made while the run is stopped
+// (SIGSTOP), 20 frames after the last picture on disk, so that the run has not reached it.
+TEST_F(FrameImagesTest, PictureThatCannotBeWrittenFailsTheRunAsWhenDrawnInline) {
+  const fs::path scene = write("long.json", kLongClothWithCamera);
+  const fs::path run_dir = out_ / "long";
+  for (const bool drawing_thread : {true, false}) {
+    SCOPED_TRACE(drawing_thread ? "drawing thread" : "CLOTHSIM_RENDER_THREAD=0");
+    std::error_code ec;
+    fs::remove_all(out_, ec);
+    if (!drawing_thread) ::setenv("CLOTHSIM_RENDER_THREAD", "0", 1);
+    const fs::path log = dir_ / (drawing_thread ? "threaded.txt" : "inline.txt");
+    const pid_t pid = clothsim::testing::spawn_process(CLOTHSIM_BINARY, {scene.string(), "--out", out_.string()}, log);
+    ::unsetenv("CLOTHSIM_RENDER_THREAD");
+    ASSERT_GT(pid, 0);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    bool exited = false;
+    while (!fs::exists(run_dir / "frame_0003.png") && std::chrono::steady_clock::now() < deadline) {
+      if (::waitpid(pid, nullptr, WNOHANG) == pid) {
+        exited = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    ASSERT_FALSE(exited) << read_file_bytes(log);
+    ::kill(pid, SIGSTOP);
+    int last = -1;
+    for (const auto& e : fs::directory_iterator(run_dir)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind("frame_", 0) == 0 && name.size() == 14 && e.path().extension() == ".png")
+        last = std::max(last, std::stoi(name.substr(6, 4)));
+    }
+    const int blocked = last + 20;
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame_%04d.png", blocked);
+    fs::create_directory(run_dir / name);
+    ::kill(pid, SIGCONT);
+    int status = 0;
+    while (::waitpid(pid, &status, WNOHANG) != pid) {
+      if (std::chrono::steady_clock::now() > deadline + std::chrono::seconds(60)) {
+        ::kill(pid, SIGKILL);
+        ::waitpid(pid, &status, 0);
+        FAIL() << "the run did not stop at frame " << blocked << ": " << read_file_bytes(log);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ASSERT_TRUE(WIFEXITED(status)) << read_file_bytes(log);
+    EXPECT_EQ(WEXITSTATUS(status), 1);
+
+    // Frame k shows t = k / 200 s, the state after step 5 k (dt = 1 ms).
+    const int step = 5 * blocked;
+    const std::string err = read_file_bytes(log);
+    EXPECT_TRUE(contains(err, "clothsim: error: " + scene.string() + ": step " + std::to_string(step) + " (t = " +
+                                  std::to_string(step * 0.001) + " s): write_png: writing " +
+                                  (run_dir / name).string() + " failed: "))
+        << err;
+    EXPECT_FALSE(contains(err, "rendering failed")) << err;  // reported once, as the error
+    const nlohmann::json summary = nlohmann::json::parse(read_file_bytes(run_dir / "summary.json"));
+    EXPECT_EQ(summary["status"], "failed");
+    EXPECT_TRUE(contains(summary["error"].get<std::string>(), name)) << summary["error"];
+    fs::remove(run_dir / name);
+    const std::vector<fs::path> files = frame_files(run_dir);  // numbered 0, 1, ... without gaps
+    EXPECT_EQ(static_cast<int>(files.size()), blocked);
+    for (const fs::path& file : files) EXPECT_EQ(clothsim::render::read_png(file.string()).width, 160) << file;
+    for (const auto& e : fs::directory_iterator(run_dir))
+      EXPECT_FALSE(contains(e.path().filename().string(), ".tmp")) << "left behind: " << e.path();
   }
 }
 

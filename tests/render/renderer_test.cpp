@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -335,6 +336,30 @@ TEST(RendererTest, AnimationFramesMatchFramesDrawnAfresh) {
       }
     }
   }
+}
+
+// A renderer handed from thread to thread (release_context on the one that is done) draws the
+// same pixels on each.
+TEST(RendererTest, ReleasedContextRendersOnAnotherThread) {
+  const Frame frame = animation_frame(0.5f, true, true);
+  Renderer renderer(frame.width, frame.height);
+  const Image here = renderer.render(frame);
+  renderer.release_context();
+  Image there;
+  std::string error;
+  std::thread other([&] {
+    try {
+      there = renderer.render(frame);
+      there = renderer.render(frame);  // over the backdrop
+      renderer.release_context();
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+  });
+  other.join();
+  ASSERT_EQ(error, "");
+  EXPECT_EQ(there.rgb, here.rgb);
+  EXPECT_EQ(renderer.render(frame).rgb, here.rgb);  // and back on this thread
 }
 
 // The 12 triangles of the box [lo, hi], outward-facing.
