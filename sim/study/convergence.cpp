@@ -740,7 +740,7 @@ ToleranceSummary summarize_tolerance_series(const std::vector<ConvergenceRow>& r
   std::map<std::string, size_t> group_of;
   for (const ConvergenceRow& r : rows) {
     if (r.series != "tolerance" || !r.tolerance) continue;
-    const std::string key = r.case_name + "\n" + r.method + "\n" + format_shortest(r.dt);
+    const std::string key = r.case_name + "\n" + r.method + "\n" + r.setting.substr(0, r.setting.find(" tol="));
     const auto [it, added] = group_of.emplace(key, groups.size());
     if (added) groups.emplace_back();
     groups[it->second].push_back(&r);
@@ -751,6 +751,7 @@ ToleranceSummary summarize_tolerance_series(const std::vector<ConvergenceRow>& r
     ToleranceSettingCheck check;
     check.case_name = group.front()->case_name;
     check.method = group.front()->method;
+    check.setting = group.front()->setting.substr(0, group.front()->setting.find(" tol="));
     check.dt = group.front()->dt;
     std::vector<std::string> windows;
     std::set<double> tolerances;
@@ -856,21 +857,21 @@ void write_tolerance_summary_markdown(std::ostream& out, const ToleranceSummary&
       << format_shortest(rule.baseline) << " and the tight run; a window is resolved when none of them has a solver "
       << "error above " << format_shortest(rule.max_amplification)
       << " × its tolerance (after buckling, perturbations grow by orders of magnitude).\n\n"
-         "| case | method | dt [s] | window | discretisation error | baseline runs' solver error | "
-         "largest solver error / tolerance | resolved | loosest passing |\n|---|---|--:|---|--:|--:|--:|---|--:|\n";
+         "| case | method | setting | window | discretisation error | baseline runs' solver error | "
+         "largest solver error / tolerance | resolved | loosest passing |\n|---|---|---|---|--:|--:|--:|---|--:|\n";
   for (const ToleranceSettingCheck& s : summary.settings)
     for (const ToleranceWindowCheck& w : s.windows)
-      out << "| " << markdown_cell(s.case_name) << " | " << markdown_cell(s.method) << " | " << format_shortest(s.dt)
+      out << "| " << markdown_cell(s.case_name) << " | " << markdown_cell(s.method) << " | " << markdown_cell(s.setting)
           << " | " << markdown_cell(w.window) << " | " << format_significant(w.discretization_error, 3) << " | "
           << format_significant(w.baseline_solver_error, 3) << " | " << format_significant(w.amplification, 2) << " | "
           << (w.resolved ? "yes" : "no") << " | "
           << (w.loosest ? format_shortest(*w.loosest) : std::string("none")) << " |\n";
   out << "\nEnd state (post-buckling measures) of the candidates looser than the baseline against the spread of "
          "the baseline runs:\n\n"
-         "| case | method | dt [s] | energy spread | folds circ. | folds axial | candidates outside the spread |\n"
-         "|---|---|--:|--:|--:|--:|---|\n";
+         "| case | method | setting | energy spread | folds circ. | folds axial | candidates outside the spread |\n"
+         "|---|---|---|--:|--:|--:|---|\n";
   for (const ToleranceSettingCheck& s : summary.settings)
-    out << "| " << markdown_cell(s.case_name) << " | " << markdown_cell(s.method) << " | " << format_shortest(s.dt)
+    out << "| " << markdown_cell(s.case_name) << " | " << markdown_cell(s.method) << " | " << markdown_cell(s.setting)
         << " | " << format_significant(s.energy_spread, 3) << " | "
         << range(s.folds_circumferential_min, s.folds_circumferential_max) << " | "
         << range(s.folds_axial_min, s.folds_axial_max) << " | " << list(s.outside_spread) << " |\n";

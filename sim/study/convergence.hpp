@@ -296,10 +296,12 @@ struct ToleranceWindowCheck {
   std::optional<double> loosest;
 };
 
-// One setting of the tolerance series: its windows, and its end state against the spread.
+// One setting (case, method, mesh and time step) of the tolerance series: its windows, and its end
+// state against the spread.
 struct ToleranceSettingCheck {
   std::string case_name;
   std::string method;
+  std::string setting;             // the rows' setting without its tolerance: "26x19 dt=0.001"
   double dt = 0.0;                 // [s]
   double tight_tolerance = 0.0;
   std::vector<double> candidates;  // loose to tight
@@ -328,7 +330,8 @@ struct ToleranceSummary {
   std::optional<double> recommended;
 };
 
-// Applies `rule` to the rows of series "tolerance" (grouped by case, method and time step).
+// Applies `rule` to the rows of series "tolerance" (grouped by case, method and setting — mesh and
+// time step, the part of `setting` before " tol=").
 ToleranceSummary summarize_tolerance_series(const std::vector<ConvergenceRow>& rows, const ToleranceRule& rule = {});
 
 // The summary as Markdown: one table row per setting and window, the end-state check and the

@@ -276,14 +276,15 @@ TEST(ConvergenceStudy, ToleranceSeriesOnTheQuickPlan) {
 }
 
 // A tolerance-series row for summarize_tolerance_series (only the fields it reads).
-ConvergenceRow tolerance_row(double dt, double tolerance, const std::string& window, double solver_error,
+ConvergenceRow tolerance_row(const std::string& mesh, double tolerance, const std::string& window, double solver_error,
                              double discretization_error, double energy_error, double circumferential, double axial) {
   ConvergenceRow r;
   r.case_name = "sleeve_made_up";
   r.method = "loop_one_point";
   r.series = "tolerance";
   r.window = window;
-  r.dt = dt;
+  r.dt = 1e-3;
+  r.setting = mesh + " dt=0.001 tol=" + format_shortest(tolerance);
   r.tolerance = tolerance;
   r.error = 0.5;
   r.solver_error = solver_error;
@@ -294,32 +295,35 @@ ConvergenceRow tolerance_row(double dt, double tolerance, const std::string& win
   return r;
 }
 
-// The rule on made-up rows (ratio 1/10; baseline 1e-8: 1e-8 is a candidate and a baseline run,
-// 1e-9 a baseline run, 1e-12 the tight run; amplification limit 1e3):
-//  - dt 1 ms, "early" (discretisation error 0.01, bound 1e-3): 1e-2 passes (5e-4), 1e-3 fails
+// The rule on made-up rows of two settings at the same time step (ratio 1/10; baseline 1e-8: 1e-8
+// is a candidate and a baseline run, 1e-9 a baseline run, 1e-12 the tight run; amplification
+// limit 1e3):
+//  - 26 × 19, "early" (discretisation error 0.01, bound 1e-3): 1e-2 passes (5e-4), 1e-3 fails
 //    (2e-3), 1e-4 and 1e-8 pass: the loosest passing with every tighter candidate passing is 1e-4;
 //    "long": the baseline runs' solver error 0.5 is 5e8 times 1e-9, so the window is unresolved
 //    and does not count. End state: the baseline runs span 10 % energy and 5–6 / 1 folds; 1e-3
 //    (20 %) and 1e-4 (7 folds) lie outside (no energy discretisation error given).
-//  - dt 0.5 ms: "early" passes down from 1e-2, "long" (bound 0.03) from 1e-3.
+//  - 52 × 37: "early" passes down from 1e-2, "long" (bound 0.03) from 1e-3.
 // Recommended: the tightest of 1e-4, 1e-2, 1e-3.
 TEST(ConvergenceStudy, ToleranceRuleOnMadeUpRows) {
   std::vector<ConvergenceRow> rows;
-  auto add = [&](double dt, double tolerance, double early, double late, double energy, double circ, double axial) {
-    rows.push_back(tolerance_row(dt, tolerance, "early", early, dt == 1e-3 ? 0.01 : 0.02, energy, circ, axial));
-    rows.push_back(tolerance_row(dt, tolerance, "long", late, 0.3, energy, circ, axial));
+  const std::string a_mesh = "26x19", b_mesh = "52x37";
+  auto add = [&](const std::string& mesh, double tolerance, double early, double late, double energy, double circ,
+                 double axial) {
+    rows.push_back(tolerance_row(mesh, tolerance, "early", early, mesh == a_mesh ? 0.01 : 0.02, energy, circ, axial));
+    rows.push_back(tolerance_row(mesh, tolerance, "long", late, 0.3, energy, circ, axial));
   };
-  add(1e-3, 1e-2, 5e-4, 0.6, 0.05, 5, 1);
-  add(1e-3, 1e-3, 2e-3, 0.4, 0.2, 6, 1);
-  add(1e-3, 1e-4, 1e-5, 0.5, 0.0, 7, 1);
-  add(1e-3, 1e-8, 1e-9, 0.5, 0.0, 5, 1);
-  add(1e-3, 1e-9, 1e-10, 0.5, 0.1, 6, 1);
-  add(1e-3, 1e-12, 0.0, 0.0, 0.0, 5, 1);
-  add(5e-4, 1e-2, 1e-3, 0.05, 0.0, 5, 1);
-  add(5e-4, 1e-3, 1e-4, 0.01, 0.0, 5, 1);
-  add(5e-4, 1e-4, 1e-5, 0.001, 0.0, 5, 1);
-  add(5e-4, 1e-9, 1e-10, 1e-9, 0.0, 5, 1);
-  add(5e-4, 1e-12, 0.0, 0.0, 0.0, 5, 1);
+  add(a_mesh, 1e-2, 5e-4, 0.6, 0.05, 5, 1);
+  add(a_mesh, 1e-3, 2e-3, 0.4, 0.2, 6, 1);
+  add(a_mesh, 1e-4, 1e-5, 0.5, 0.0, 7, 1);
+  add(a_mesh, 1e-8, 1e-9, 0.5, 0.0, 5, 1);
+  add(a_mesh, 1e-9, 1e-10, 0.5, 0.1, 6, 1);
+  add(a_mesh, 1e-12, 0.0, 0.0, 0.0, 5, 1);
+  add(b_mesh, 1e-2, 1e-3, 0.05, 0.0, 5, 1);
+  add(b_mesh, 1e-3, 1e-4, 0.01, 0.0, 5, 1);
+  add(b_mesh, 1e-4, 1e-5, 0.001, 0.0, 5, 1);
+  add(b_mesh, 1e-9, 1e-10, 1e-9, 0.0, 5, 1);
+  add(b_mesh, 1e-12, 0.0, 0.0, 0.0, 5, 1);
   ConvergenceRow other = rows.front();  // rows of other series are ignored
   other.series = "mesh";
   other.solver_error = 1.0;
@@ -328,6 +332,7 @@ TEST(ConvergenceStudy, ToleranceRuleOnMadeUpRows) {
   const ToleranceSummary summary = summarize_tolerance_series(rows);
   ASSERT_EQ(summary.settings.size(), 2u);
   const ToleranceSettingCheck& a = summary.settings[0];
+  EXPECT_EQ(a.setting, "26x19 dt=0.001");
   EXPECT_EQ(a.dt, 1e-3);
   EXPECT_EQ(a.tight_tolerance, 1e-12);
   EXPECT_EQ(a.candidates, (std::vector<double>{1e-2, 1e-3, 1e-4, 1e-8}));
@@ -349,6 +354,7 @@ TEST(ConvergenceStudy, ToleranceRuleOnMadeUpRows) {
   EXPECT_EQ(a.folds_axial_max, 1.0);
   EXPECT_EQ(a.outside_spread, (std::vector<double>{1e-3, 1e-4}));
   const ToleranceSettingCheck& b = summary.settings[1];
+  EXPECT_EQ(b.setting, "52x37 dt=0.001");
   EXPECT_EQ(b.candidates, (std::vector<double>{1e-2, 1e-3, 1e-4}));
   EXPECT_EQ(b.windows[0].loosest, std::optional<double>(1e-2));
   EXPECT_TRUE(b.windows[1].resolved);
@@ -359,7 +365,7 @@ TEST(ConvergenceStudy, ToleranceRuleOnMadeUpRows) {
   std::ostringstream md;
   write_tolerance_summary_markdown(md, summary);
   EXPECT_NE(md.str().find("Recommended tolerance by the rule: 1e-04\n"), std::string::npos) << md.str();
-  EXPECT_NE(md.str().find("| sleeve_made_up | loop_one_point | 0.001 | long | 0.3 | 0.5 | 5e+08 | no | none |"),
+  EXPECT_NE(md.str().find("| sleeve_made_up | loop_one_point | 26x19 dt=0.001 | long | 0.3 | 0.5 | 5e+08 | no | none |"),
             std::string::npos)
       << md.str();
 
@@ -371,8 +377,7 @@ TEST(ConvergenceStudy, ToleranceRuleOnMadeUpRows) {
 
   // A resolved window in which even the tightest candidate fails: no recommendation.
   ConvergenceRow& b_early_1e4 = rows[16];
-  ASSERT_EQ(b_early_1e4.dt, 5e-4);
-  ASSERT_EQ(*b_early_1e4.tolerance, 1e-4);
+  ASSERT_EQ(b_early_1e4.setting, "52x37 dt=0.001 tol=1e-04");
   ASSERT_EQ(b_early_1e4.window, "early");
   b_early_1e4.solver_error = 0.05;  // bound 2e-3
   const ToleranceSummary failing = summarize_tolerance_series(rows);
