@@ -5,7 +5,10 @@
 //   multilevel_bench --systems DIR --setup 20 --solve 20,21,23,25 --candidates cholesky,block_jacobi,...
 //                    [--repeat 3] [--threads 2] [--max-iterations 1000]
 //                    [--petsc LABEL "OPTIONS"]...      (with PETSc: candidate petsc:LABEL)
-//                    [--multilevel LABEL "KEY=VALUE ..."]... (candidate ml:LABEL, sim/solver/multilevel_preconditioner.hpp)
+//                    [--multilevel LABEL "KEY=VALUE ..."]... (candidate ml:LABEL, sim/solver/multilevel_preconditioner.hpp;
+//                                                             mcm:LABEL, the stale Cholesky factor between two V-cycles)
+//                    [--timing ROUNDS]   unit costs (product with A, applications, set-ups, refreshes) timed
+//                                        in alternation, ROUNDS rounds, medians
 //
 // Every candidate is set up on DIR/step_<setup>.sys and then preconditions the solve of each
 // DIR/step_<solve>.sys (a later step: the preconditioner is stale, as the simulator uses it). The
@@ -390,6 +393,7 @@ int run(int argc, char** argv) {
   std::vector<int> solve_steps;
   std::vector<std::string> candidates;
   std::map<std::string, std::string> petsc_options, multilevel_options;
+  int timing_rounds = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     auto value = [&]() -> std::string {
@@ -403,6 +407,7 @@ int run(int argc, char** argv) {
     else if (arg == "--repeat") repeat = std::stoi(value());
     else if (arg == "--threads") threads = std::stoi(value());
     else if (arg == "--max-iterations") max_iterations = std::stoi(value());
+    else if (arg == "--timing") timing_rounds = std::stoi(value());
     else if (arg == "--petsc") {
       const std::string label = value();
       petsc_options[label] = value();
@@ -414,7 +419,7 @@ int run(int argc, char** argv) {
       return 2;
     }
   }
-  if (dir.empty() || candidates.empty()) throw std::runtime_error("--systems and --candidates are required");
+  if (dir.empty() || (candidates.empty() && timing_rounds == 0)) throw std::runtime_error("--systems and --candidates are required");
   if (solve_steps.empty()) solve_steps = {setup_step};
   std::unique_ptr<tbb::global_control> limit;
   if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
@@ -438,6 +443,40 @@ int run(int argc, char** argv) {
       t.push_back(ms_since(t0));
     }
     std::printf("# product with A (symmetric_product): %.3f ms (median of 21)\n", median(t));
+  }
+  if (timing_rounds > 0) {
+    // Unit costs, alternating: each round times every operation once, in the same minutes.
+    const Eigen::VectorXd mask = free_mask(setup_system.free);
+    CholeskyPreconditioner factor;
+    if (!factor.factorize(setup_system.a, &setup_system.free)) throw std::runtime_error("cholesky failed");  // analysis
+    MultilevelPreconditioner multilevel(parse_multilevel_settings(""));
+    if (!multilevel.setup(setup_system.a, setup_system.free, setup_system.positions)) throw std::runtime_error("multilevel failed");
+    const char* names[] = {"product with A", "Cholesky apply", "multilevel apply (V-cycle)", "Cholesky factorisation (analysis reused)",
+                           "multilevel set-up", "multilevel refresh, level 0", "multilevel refresh, Galerkin"};
+    std::vector<double> t[7];
+    Eigen::VectorXd y, z;
+    for (int round = 0; round < timing_rounds; ++round) {
+      auto time = [&](int k, auto&& f) {
+        const auto t0 = Clock::now();
+        f();
+        t[k].push_back(ms_since(t0));
+      };
+      for (int rep = 0; rep < 5; ++rep) time(0, [&] { symmetric_product(setup_system.a, setup_system.b, mask, y); });
+      for (int rep = 0; rep < 3; ++rep) time(1, [&] { factor.apply(setup_system.b, z); });
+      for (int rep = 0; rep < 3; ++rep) time(2, [&] { multilevel.apply(setup_system.b, z); });
+      time(3, [&] { factor.factorize(setup_system.a, &setup_system.free); });
+      time(4, [&] { multilevel.setup(setup_system.a, setup_system.free, setup_system.positions); });
+      time(5, [&] { multilevel.refresh(setup_system.a, false); });
+      time(6, [&] { multilevel.refresh(setup_system.a, true); });
+    }
+    std::printf("| operation | median ms | min ms | in products with A |\n|---|--:|--:|--:|\n");
+    const double unit = median(t[0]);
+    for (int k = 0; k < 7; ++k)
+      std::printf("| %s | %.3f | %.3f | %.1f |\n", names[k], median(t[k]), *std::min_element(t[k].begin(), t[k].end()),
+                  median(t[k]) / unit);
+    std::printf("# multilevel: %s; Cholesky: %ld entries\n", multilevel.describe().c_str(), factor.factor_entries());
+    std::printf("# peak resident set %.0f MiB\n", peak_mib());
+    if (candidates.empty()) return 0;
   }
   std::printf("| candidate | set-up step | solve step | set-up ms | it 1e-4 | ms 1e-4 | it 1e-6 | ms 1e-6 | it 1e-8 | ms 1e-8 | "
               "memory MiB | apply ms | A·x ms | error | notes |\n|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|---|\n");

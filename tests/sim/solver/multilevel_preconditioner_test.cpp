@@ -88,8 +88,11 @@ TEST(MultilevelPreconditioner, ConvergesOnASleeveSystemFasterThanBlockJacobi) {
   // Zero at the held rows, whatever r holds there.
   Eigen::VectorXd z;
   m.apply(Eigen::VectorXd::Ones(s.a.rows()), z);
-  for (std::size_t i = 0; i < s.free.size(); ++i)
-    if (!s.free[i]) EXPECT_EQ(z(static_cast<Eigen::Index>(i)), 0.0);
+  for (std::size_t i = 0; i < s.free.size(); ++i) {
+    if (!s.free[i]) {
+      EXPECT_EQ(z(static_cast<Eigen::Index>(i)), 0.0);
+    }
+  }
 }
 
 // Same inputs, same bytes: two set-ups, and one thread against all of them.
