@@ -475,7 +475,7 @@ TEST_F(SceneLoader, DynamicDefaults) {
   EXPECT_DOUBLE_EQ(d.damping.mass, 0.0);
   EXPECT_EQ(d.solver.type, LinearSolverType::automatic);
   EXPECT_EQ(d.solver.preconditioner, PreconditionerType::automatic);
-  EXPECT_DOUBLE_EQ(d.solver.tolerance, 1e-8);
+  EXPECT_DOUBLE_EQ(d.solver.tolerance, 1e-5);
   EXPECT_EQ(d.solver.max_iterations, 2000);
   EXPECT_EQ(d.solver.newton_iterations, 1);
   EXPECT_TRUE(d.corotational);
