@@ -12,7 +12,7 @@ solid, axial median dashed, the reference run's counts as grey horizontal lines)
 dynamic case with a tolerance series (rows of series "tolerance") two more: the solver error (the run
 against its setting's tight-tolerance run) against the linear solver's tolerance, log-log, with the
 discretisation error of each setting (its tight run against the reference) as a thin horizontal
-line in the same colour and line style; and the wall time per run (solid, left axis, log) and PCG
+line in the same colour and line style, labelled with its mesh and window; and the wall time per run (solid, left axis, log) and PCG
 iterations per step (dashed, right axis) against the tolerance. Colour
 = method (the same in every panel, so later baseline methods are new colours), marker and line
 style = plate case (plates panel) or series and error window (dynamic panels: solid = mesh
@@ -254,6 +254,8 @@ def draw_tolerance_error_panel(ax, rows, case, colour):
     for (method, base, window), level in levels.items():
         ax.axhline(level, color=colour[method], linestyle="-" if window == windows[0] else ":", linewidth=0.9,
                    alpha=0.55, zorder=0)
+        ax.annotate(f"{base.split(' ')[0]} {window}", (0.01, level), xycoords=("axes fraction", "data"), ha="left",
+                    va="bottom", fontsize=6, color=colour[method], alpha=0.8)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("linear solver tolerance (relative residual) [-]")
