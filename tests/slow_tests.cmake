@@ -10,6 +10,7 @@
 # Install.InstalledClothsimRunsWithoutTheSourceTree (18 s; added after this file is included, so
 # it could not be labelled here).
 set(clothsim_slow_tests
+  "MultilevelPreconditioner.IterationsDoNotGrowWithRefinement"  # 3.2 s in Release; not measured here (estimated > 8 s)
   "TwistedSleeve.DevelopsACircumferentialFoldWave"  # 242 s
   "StudyStabilityCli.QuickWithoutPlotWritesTheReport"  # 237 s
   "Vibration.CantileverStripMatchesTheFirstBendingFrequency"  # 130 s
