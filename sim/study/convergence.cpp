@@ -376,7 +376,7 @@ class StudyRunner {
       if (dt_series)
         for (double dt : c.dts) add(method, "dt", c.dt_mesh, dt);
     }
-    // The tolerance series, after the others (its runs at the scene's own tolerance may be theirs).
+    // The tolerance series, after the others (its runs at their tolerance, 1e-8, may be theirs).
     for (const ToleranceSetting& setting : c.tolerance_settings) {
       if (c.tolerances.empty()) break;
       const auto it = std::find_if(methods_.begin(), methods_.end(),
@@ -446,7 +446,8 @@ class StudyRunner {
       if (row.note.empty()) row.note = "failed: the solver reference (tight tolerance) failed: " + tight.failure;
       return;
     }
-    if (&o == &tight && row.note.empty()) row.note = "the solver reference of this setting (solver error 0 by definition)";
+    if (&o == &tight && row.note.empty())
+      row.note = "the solver reference of this setting (solver error 0 by definition)";
     const std::vector<Eigen::MatrixX3d> u_tight = window_samples(tight.run.displacements, times, window);
     if (reference.failure.empty())
       row.discretization_error =
@@ -457,7 +458,8 @@ class StudyRunner {
     row.solver_reference_folds_axial = tight.folds_axial;
     if (!o.failure.empty()) return;
     row.solver_error = relative_rms_difference(window_samples(o.run.displacements, times, window), u_tight);
-    if (o.energy && tight.energy) row.solver_energy_error = std::abs(*o.energy - *tight.energy) / std::abs(*tight.energy);
+    if (o.energy && tight.energy)
+      row.solver_energy_error = std::abs(*o.energy - *tight.energy) / std::abs(*tight.energy);
   }
 
   static bool listed(const std::vector<std::string>& names, const std::string& name) {
@@ -622,8 +624,8 @@ ConvergencePlan full_convergence_plan(const std::filesystem::path& scenes_dir) {
     // The tolerance series with the scenes' own rule (one-point) at their own time step (1 ms): on
     // the shipped mesh (what users run) and on the reference mesh (a finer mesh has a smaller
     // discretisation error and a worse-conditioned system; there the 1e-8 run is the time-step
-    // series'). The candidates 1e-2 … 1e-8 (today's default), one more baseline run at 1e-10 and
-    // the tight run (ToleranceRule, docs/convergence.md "Solver tolerance").
+    // series'). The candidates 1e-2 … 1e-8 (the other series' tolerance), one more baseline run at
+    // 1e-10 and the tight run (ToleranceRule, docs/convergence.md "Solver tolerance").
     c.tolerances = {1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-10};
     c.tight_tolerance = 1e-12;
     c.tolerance_settings = {{"loop_one_point", {26, 19}, 1e-3}, {"loop_one_point", meshes.back(), 1e-3}};
@@ -648,7 +650,7 @@ ConvergencePlan quick_convergence_plan(const std::filesystem::path& scenes_dir) 
   c.dt_series_methods = {"loop_one_point", "loop_three_point"};  // as the full plan
   c.reference_mesh = {16, 11};
   c.reference_dt = 1e-3;
-  // Candidates 1e-2, 1e-3, 1e-5, 1e-8 (the last the scene's own: its run is the mesh series'), one
+  // Candidates 1e-2, 1e-3, 1e-5, 1e-8 (the last the other series': its run is the mesh series'), one
   // more baseline run and the tight run, with both Loop rules at the mesh series' time step.
   c.tolerances = {1e-2, 1e-3, 1e-5, 1e-8, 1e-10};
   c.tight_tolerance = 1e-12;

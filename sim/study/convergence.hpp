@@ -260,17 +260,18 @@ void write_results_csv(std::ostream& out, const std::vector<ConvergenceRow>& row
 void write_results_markdown(std::ostream& out, const std::vector<ConvergenceRow>& rows);
 
 // The rule that chooses the linear solver's tolerance from the tolerance series
-// (docs/convergence.md, "Solver tolerance"). Of a setting's (case, method, time step) tolerance
-// runs, those at tolerances >= baseline other than the tight run are the *candidates* (loose to
-// tight); those at tolerances <= baseline, the tight run included, are the *baseline runs*:
-// today's default and tighter, they differ from the tight run only by perturbations far below
+// (docs/convergence.md, "Solver tolerance"). Of a setting's (case, method, mesh and time step)
+// tolerance runs, those at tolerances >= baseline other than the tight run are the *candidates*
+// (loose to tight); those at tolerances <= baseline, the tight run included, are the *baseline
+// runs*: the study's other series' tolerance (kSeriesTolerance, the scenes' default before this
+// rule chose 1e-5) and tighter, they differ from the tight run only by perturbations far below
 // any discretisation error, which after a buckling bifurcation are amplified and decide the end
 // state — their differences are the run-to-run spread of that state.
 //  - A window is *resolved* when no baseline run (other than the tight one) has a solver error
 //    above max_amplification × its tolerance. Before a bifurcation the solver error is at most a
-//    few times the tolerance; after one, perturbations grow by many orders of magnitude and the
-//    window's norm measures that growth, not the solver's accuracy. Unresolved windows do not
-//    enter the rule.
+//    few dozen times the tolerance (measured up to 61); after one, perturbations grow by many
+//    orders of magnitude and the window's norm measures that growth, not the solver's accuracy.
+//    Unresolved windows do not enter the rule.
 //  - In a resolved window, the loosest candidate whose solver error, and that of every tighter
 //    candidate, is at most ratio × the discretisation error (the tight run against the reference).
 //  - The end state (elastic energy and fold counts at the end of the run) of every candidate looser
@@ -278,7 +279,7 @@ void write_results_markdown(std::ostream& out, const std::vector<ConvergenceRow>
 //    ratio × its discretisation error).
 struct ToleranceRule {
   double ratio = 0.1;               // solver error at most ratio × the discretisation error
-  double baseline = 1e-8;           // [-] today's default tolerance
+  double baseline = 1e-8;           // [-] the tolerance of the study's other series
   double max_amplification = 1e3;   // largest solver error / tolerance of a resolved window's baseline runs
 };
 

@@ -184,7 +184,8 @@ TEST(ConvergenceBaselines, PostBucklingColumnsOfSyntheticRunsWithKnownFolds) {
   EXPECT_NEAR(*bellows.energy_error, 0.75, 1e-15);
 
   // The CSV carries them as the nine fields after `note`, then the run's solver tolerance (the
-  // scene's 1e-8) and the tolerance series' columns (empty: not a tolerance-series row).
+  // study's 1e-8 for its other series) and the tolerance series' columns (empty: not a
+  // tolerance-series row).
   std::ostringstream csv;
   write_results_csv(csv, {five});
   const std::string line = csv.str().substr(csv.str().find('\n') + 1);

@@ -216,7 +216,7 @@ TEST(ConvergenceStudy, SleeveSeriesAgainstTheFinestRun) {
 // the tight run at 1e-12): every run reports the tolerance it was solved to; the tight run's solver
 // error is 0 and looser tolerances give larger solver errors and fewer iterations; every row of a
 // setting carries the tight run's error as its discretisation error, and total, discretisation and
-// solver error obey the triangle inequality; the run at the scene's own tolerance (1e-8) is the
+// solver error obey the triangle inequality; the run at the other series' tolerance (1e-8) is the
 // mesh series' 12 × 9 run.
 TEST(ConvergenceStudy, ToleranceSeriesOnTheQuickPlan) {
   ConvergencePlan plan = quick_convergence_plan(CLOTHSIM_SOURCE_DIR "/scenes");
@@ -241,7 +241,8 @@ TEST(ConvergenceStudy, ToleranceSeriesOnTheQuickPlan) {
         EXPECT_EQ(r.window, "early");
         continue;
       }
-      // Every other sleeve run is solved to the scene's own tolerance and has no solver error.
+      // Every other sleeve run is solved to the study's 1e-8 (kSeriesTolerance) and has no solver
+      // error.
       EXPECT_EQ(r.tolerance, std::optional<double>(1e-8)) << r.series << " " << r.setting;
       EXPECT_FALSE(r.solver_error.has_value()) << r.series << " " << r.setting;
       if (r.method == method.name && r.series == "mesh" && r.setting == "12x9 dt=0.002") mesh_12x9 = &r;
@@ -269,7 +270,7 @@ TEST(ConvergenceStudy, ToleranceSeriesOnTheQuickPlan) {
     EXPECT_GT(*at.at(1e-3)->solver_error, *at.at(1e-8)->solver_error);
     EXPECT_GT(*at.at(1e-2)->solver_error, *at.at(1e-5)->solver_error);
     EXPECT_LT(at.at(1e-2)->solver_iterations, tight.solver_iterations);
-    // The run at the scene's own tolerance is the mesh series' run.
+    // The run at 1e-8 is the mesh series' run.
     EXPECT_EQ(at.at(1e-8)->wall_seconds, mesh_12x9->wall_seconds);
     EXPECT_EQ(at.at(1e-8)->error, mesh_12x9->error);
   }
