@@ -366,13 +366,6 @@ Trace pcg(const bench::StepSystem& s, Candidate& candidate, int max_iterations) 
   return trace;
 }
 
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(std::stoi(item));
-  return out;
-}
 std::vector<std::string> parse_names(const std::string& text) {
   std::vector<std::string> out;
   std::stringstream in(text);
@@ -402,7 +395,7 @@ int run(int argc, char** argv) {
     };
     if (arg == "--systems") dir = value();
     else if (arg == "--setup") setup_step = std::stoi(value());
-    else if (arg == "--solve") solve_steps = parse_list(value());
+    else if (arg == "--solve") solve_steps = bench::parse_list(value());
     else if (arg == "--candidates") candidates = parse_names(value());
     else if (arg == "--repeat") repeat = std::stoi(value());
     else if (arg == "--threads") threads = std::stoi(value());

@@ -49,14 +49,6 @@ class SystemRecorder final : public ForceTerm {
   mutable Eigen::VectorXd force_;
 };
 
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(std::stoi(item));
-  return out;
-}
-
 int run(int argc, char** argv) {
   std::string scene_file = std::string(CLOTHSIM_SOURCE_DIR) + "/scenes/sleeve_compress_2542.json";
   int segments = 62, rings = 41, steps = 25;
@@ -73,7 +65,7 @@ int run(int argc, char** argv) {
     if (arg == "--segments") segments = std::stoi(value());
     else if (arg == "--rings") rings = std::stoi(value());
     else if (arg == "--steps") steps = std::stoi(value());
-    else if (arg == "--dump") for (int s : parse_list(value())) dump.insert(s);
+    else if (arg == "--dump") for (int s : bench::parse_list(value())) dump.insert(s);
     else if (arg == "--out") out_dir = value();
     else if (arg == "--scene") scene_file = value();
     else if (arg == "--set") overrides.push_back(value());

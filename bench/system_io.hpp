@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -49,6 +50,15 @@ void get(std::ifstream& in, T* data, std::size_t count, const std::string& path)
   if (!in) throw std::runtime_error(path + ": truncated system file");
 }
 }  // namespace system_io_detail
+
+// "1,5,20" -> {1, 5, 20} (the benches' step lists).
+inline std::vector<int> parse_list(const std::string& text) {
+  std::vector<int> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(std::stoi(item));
+  return out;
+}
 
 inline void write_system(const std::string& path, const StepSystem& s) {
   using system_io_detail::put;

@@ -38,7 +38,7 @@ const char* to_string(PreconditionerType preconditioner) {
 
 LinearSolverSettings resolve_automatic(const LinearSolverSettings& settings, Eigen::Index unknowns) {
   LinearSolverSettings s = settings;
-  (void)unknowns;
+  (void)unknowns;  // every size measured (205 to 5856 vertices) gave the same choice
   // Conjugate gradients: a direct factorisation every step costs 5-7 times as much as PCG with a
   // refreshed factor on every shipped scene (docs/performance.md, "Automatic solver choice").
   if (s.type == LinearSolverType::automatic) s.type = LinearSolverType::pcg;
