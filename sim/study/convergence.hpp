@@ -135,6 +135,10 @@ struct ToleranceSetting {
   std::string method;  // Method::name; a setting whose method is not in the study is skipped
   SleeveMesh mesh;
   double dt = 1e-3;    // [s]
+  // The case's windows (by name) this setting is measured in; empty: all of them. Its runs sample
+  // only these windows' times, which must be multiples of dt (a setting at a large time step, such
+  // as a scene's own 0.01 s, can thus skip a window of short times).
+  std::vector<std::string> windows;
 };
 
 struct SleeveStudyCase {

@@ -276,6 +276,47 @@ TEST(ConvergenceStudy, ToleranceSeriesOnTheQuickPlan) {
   }
 }
 
+// A tolerance setting measured in one of the case's windows only (ToleranceSetting::windows): at
+// dt = 0.02 s it cannot sample the "early" window's 0.01 s, so it names "late" (0.02 s). Its rows
+// are that window's only; the tight run's discretisation error is its total error against the
+// reference, which is sampled at the case's times (a mix-up of the two time lists would compare
+// the reference's 0.01 s sample). A setting that names no window, or an unknown one, is refused.
+TEST(ConvergenceStudy, ToleranceSettingMeasuredInItsOwnWindows) {
+  ConvergencePlan plan = quick_convergence_plan(CLOTHSIM_SOURCE_DIR "/scenes");
+  plan.plates.clear();
+  ASSERT_EQ(plan.sleeves.size(), 1u);
+  SleeveStudyCase& c = plan.sleeves[0];
+  c.windows = {{"early", {0.01, 0.02}}, {"late", {0.02}}};
+  c.meshes = {{12, 9}};
+  c.dts = {1e-2};
+  c.tolerances = {1e-3};
+  c.tolerance_settings = {{"loop_one_point", {12, 9}, 0.02, {"late"}}};
+  const std::vector<Method> methods = {convergence_methods()[0]};
+  ASSERT_EQ(methods[0].name, "loop_one_point");
+  const std::vector<ConvergenceRow> rows = run_convergence(plan, methods, {});
+  std::vector<const ConvergenceRow*> tolerance_rows;
+  for (const ConvergenceRow& r : rows)
+    if (r.series == "tolerance") tolerance_rows.push_back(&r);
+  ASSERT_EQ(tolerance_rows.size(), 2u);  // 1e-3 and the tight run, in "late" only
+  for (const ConvergenceRow* r : tolerance_rows) {
+    EXPECT_EQ(r->window, "late");
+    EXPECT_EQ(r->steps, 1);
+    EXPECT_EQ(r->dt, 0.02);
+    ASSERT_TRUE(r->solver_error && r->discretization_error);
+    EXPECT_TRUE(std::isfinite(r->error));
+  }
+  const ConvergenceRow& tight = *tolerance_rows[1];
+  EXPECT_EQ(tight.setting, "12x9 dt=0.02 tol=1e-12");
+  EXPECT_EQ(*tight.solver_error, 0.0);
+  EXPECT_GT(tight.error, 0.0);
+  EXPECT_EQ(*tolerance_rows[0]->discretization_error, tight.error);
+
+  c.tolerance_settings = {{"loop_one_point", {12, 9}, 0.02, {}}};  // all windows: 0.01 s is not a step
+  EXPECT_THROW(run_convergence(plan, methods, {}), std::invalid_argument);
+  c.tolerance_settings = {{"loop_one_point", {12, 9}, 0.02, {"nope"}}};
+  EXPECT_THROW(run_convergence(plan, methods, {}), std::invalid_argument);
+}
+
 // A tolerance-series row for summarize_tolerance_series (only the fields it reads).
 ConvergenceRow tolerance_row(const std::string& mesh, double tolerance, const std::string& window, double solver_error,
                              double discretization_error, double energy_error, double circumferential, double axial) {
