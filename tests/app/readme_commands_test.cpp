@@ -146,6 +146,20 @@ const std::map<std::string, Form>& forms() {
        {{"{python} {src}/scripts/layer_count.py {tmp}/two_layers.obj"},
         "{python} {src}/scripts/layer_count.py --help",
         ""}},
+      // The timing scene's sleeve at a tiny size, two steps; the table and the plot of its rows.
+      {"scripts/scaling.py run --bin CLOTHSIM --csv OUT.csv",
+       {{"{python} {src}/scripts/scaling.py run --bin {clothsim} --csv {tmp}/scaling.csv --sizes 8x6 --end 0.02 --repeats 1",
+         "{python} {src}/scripts/scaling.py table {tmp}/scaling.csv | grep -q '| run | 48 |'",
+         "{python} {src}/scripts/scaling.py plot {tmp}/scaling.png {tmp}/scaling.csv && test -s {tmp}/scaling.png"},
+        "{python} {src}/scripts/scaling.py --help",
+        "python:matplotlib"}},
+      // Two labels on the same build, one small scene, two steps; the before/after table.
+      {"scripts/scene_times.py run --csv OUT.csv --bin LABEL=CLOTHSIM[@SCENES_DIR]",
+       {{"{python} {src}/scripts/scene_times.py run --csv {tmp}/times.csv --bin a={clothsim} --bin b={clothsim}@{src}/scenes "
+         "--steps 2 --repeats 1 --only sleeve_twist",
+         "{python} {src}/scripts/scene_times.py table {tmp}/times.csv --before a --after b | grep -q '`sleeve_twist` | 2 |'"},
+        "{python} {src}/scripts/scene_times.py --help",
+        ""}},
       {"build/release/tools/check_intersections SURFACE.obj",
        {{"{clothsim} {src}/scenes/plate_ss.json --out {tmp}/ci --no-render",
          "{build}/tools/check_intersections {tmp}/ci/plate_ss/limit.obj"},
