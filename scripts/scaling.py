@@ -161,16 +161,23 @@ def plot(out_png, paths):
     import matplotlib.pyplot as plt
     rows = medians(paths)
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    for label in sorted({m["label"] for m in rows}):
+    labels = sorted({m["label"] for m in rows})
+    for label in labels:
         ms = [m for m in rows if m["label"] == label]
         v = [m["vertices"] for m in ms]
         ax[0].plot(v, [1000.0 * m["ms_per_step"] / m["vertices"] for m in ms], "o-", label=label)
         ax[1].plot(v, [m["peak_rss_MiB"] * 1048576 / m["vertices"] / 1000 for m in ms], "o-", label=label)
+    if labels:  # linear cost within 1.5 times the smallest size's figure (issue 17's target)
+        ms = [m for m in rows if m["label"] == labels[0]]
+        base = 1000.0 * ms[0]["ms_per_step"] / ms[0]["vertices"]
+        ax[0].axhline(1.5 * base, color="grey", linestyle="--", linewidth=1,
+                      label="1.5 × %s at %d vertices" % (labels[0], ms[0]["vertices"]))
     ax[0].set_ylabel("µs per vertex per step (rotate + assemble + solve)")
     ax[1].set_ylabel("peak memory per vertex [kB]")
     for a in ax:
         a.set_xscale("log")
         a.set_xlabel("control vertices")
+        a.set_ylim(bottom=0)
         a.grid(True, which="both", alpha=0.3)
         a.legend()
     fig.suptitle("Compressed sleeve, dt = 0.01 s, medians of repeated runs")
