@@ -31,6 +31,8 @@ import subprocess
 import sys
 import tempfile
 
+from bench_cli import die, dispatch
+
 FIELDS = ["label", "segments", "rings", "vertices", "steps", "repeat", "ms_per_step", "rotate_ms", "assemble_ms",
           "solve_ms", "factor_ms", "factorizations", "iterations", "contact_ms", "wall_seconds", "peak_rss_MiB",
           "load_1min"]
@@ -38,9 +40,6 @@ DEFAULT_SIZES = "62x41,124x81,248x161,396x253"
 SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", "sleeve_compress_2542.json")
 
 
-def die(message):
-    sys.stderr.write("scaling.py: error: " + message + "\n")
-    sys.exit(2)
 
 
 def parse_sizes(text):
@@ -187,22 +186,14 @@ def plot(out_png, paths):
     os.replace(tmp, out_png)
 
 
+def plot_command(args):
+    if len(args) < 2:
+        die("plot needs OUT.png and at least one CSV")
+    plot(args[0], args[1:])
+
+
 def main():
-    if len(sys.argv) < 2 or sys.argv[1] in ("-h", "--help"):
-        print(__doc__)
-        return 0 if len(sys.argv) >= 2 else 2
-    command, args = sys.argv[1], sys.argv[2:]
-    if command == "run":
-        run(args)
-    elif command == "table":
-        table(args)
-    elif command == "plot":
-        if len(args) < 2:
-            die("plot needs OUT.png and at least one CSV")
-        plot(args[0], args[1:])
-    else:
-        die("unknown command " + command)
-    return 0
+    return dispatch(__doc__, {"run": run, "table": table, "plot": plot_command})
 
 
 if __name__ == "__main__":

@@ -31,14 +31,13 @@ import subprocess
 import sys
 import tempfile
 
+from bench_cli import die, dispatch
+
 FIELDS = ["label", "scene", "repeat", "steps", "wall_seconds", "step_seconds", "iterations", "factorizations",
           "status", "peak_rss_MiB", "load_1min"]
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def die(message):
-    sys.stderr.write("scene_times.py: error: " + message + "\n")
-    sys.exit(2)
 
 
 def dynamic_scenes(folder):
@@ -174,17 +173,7 @@ def table(args):
 
 
 def main():
-    if len(sys.argv) < 2 or sys.argv[1] in ("-h", "--help"):
-        print(__doc__)
-        return 0 if len(sys.argv) >= 2 else 2
-    command, args = sys.argv[1], sys.argv[2:]
-    if command == "run":
-        run(args)
-    elif command == "table":
-        table(args)
-    else:
-        die("unknown command " + command)
-    return 0
+    return dispatch(__doc__, {"run": run, "table": table})
 
 
 if __name__ == "__main__":
