@@ -69,6 +69,19 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
+// Median wall time of `repeats` products with the system's matrix (symmetric_product, both cores) [ms].
+double product_time(const bench::StepSystem& system, int repeats) {
+  const Eigen::VectorXd mask = free_mask(system.free);
+  Eigen::VectorXd y;
+  std::vector<double> t;
+  for (int k = 0; k < repeats; ++k) {
+    const auto t0 = Clock::now();
+    symmetric_product(system.a, system.start, mask, y);
+    t.push_back(ms_since(t0));
+  }
+  return median(t);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Candidates
 
@@ -426,17 +439,7 @@ int run(int argc, char** argv) {
   std::printf("# %d x %d sleeve: %ld vertices, %ld unknowns, %ld entries of A; set-up on step %d; threads %d\n",
               setup_system.segments, setup_system.rings, static_cast<long>(n / 3), free_count,
               static_cast<long>(setup_system.a.nonZeros()), setup_step, threads);
-  {
-    const Eigen::VectorXd mask = free_mask(setup_system.free);
-    Eigen::VectorXd y;
-    std::vector<double> t;
-    for (int k = 0; k < 21; ++k) {
-      const auto t0 = Clock::now();
-      symmetric_product(setup_system.a, setup_system.start, mask, y);
-      t.push_back(ms_since(t0));
-    }
-    std::printf("# product with A (symmetric_product): %.3f ms (median of 21)\n", median(t));
-  }
+  std::printf("# product with A (symmetric_product): %.3f ms (median of 21)\n", product_time(setup_system, 21));
   if (timing_rounds > 0) {
     // Unit costs, alternating: each round times every operation once, in the same minutes.
     const Eigen::VectorXd mask = free_mask(setup_system.free);
@@ -516,18 +519,7 @@ int run(int argc, char** argv) {
       }
       apply_ms = median(t);
     }
-    double product_ms = 0.0;  // the product with A in the same minutes, the unit of cost
-    {
-      const Eigen::VectorXd mask = free_mask(setup_system.free);
-      Eigen::VectorXd y;
-      std::vector<double> t;
-      for (int k = 0; k < 7; ++k) {
-        const auto t0 = Clock::now();
-        symmetric_product(setup_system.a, setup_system.start, mask, y);
-        t.push_back(ms_since(t0));
-      }
-      product_ms = median(t);
-    }
+    const double product_ms = product_time(setup_system, 7);  // in the same minutes: the unit of cost
     for (const bench::StepSystem& s : solves) {
       double refresh_ms = 0.0;
       if (s.step != setup_step) {
