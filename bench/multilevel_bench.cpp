@@ -7,6 +7,7 @@
 //                    [--petsc LABEL "OPTIONS"]...      (with PETSc: candidate petsc:LABEL)
 //                    [--multilevel LABEL "KEY=VALUE ..."]... (candidate ml:LABEL, sim/solver/multilevel_preconditioner.hpp;
 //                                                             mcm:LABEL, the stale Cholesky factor between two V-cycles)
+//                    (candidate warped: the stale factor turned per vertex with the cloth, z = Q C⁻¹ Qᵀ r)
 //                    [--timing ROUNDS]   unit costs (product with A, applications, set-ups, refreshes) timed
 //                                        in alternation, ROUNDS rounds, medians
 //
@@ -21,6 +22,8 @@
 #include "sim/solver/cholesky_preconditioner.hpp"
 #include "sim/solver/multilevel_preconditioner.hpp"
 #include "sim/solver/pcg.hpp"
+
+#include <Eigen/Dense>
 
 #include <malloc.h>
 #include <sys/resource.h>
@@ -119,6 +122,67 @@ class CholeskyCandidate final : public Candidate {
 
  private:
   CholeskyPreconditioner factor_;
+};
+
+// The stale Cholesky factor C of the set-up step, turned with the cloth: z = Q C⁻¹ Qᵀ r, where Q is
+// block-diagonal with one rotation per vertex, the best fit (polar factor) of the turn of the
+// vertex's neighbourhood (the vertices it couples to in A) from the set-up step's positions to the
+// solved step's. A corotational stiffness turns with its elements, A_new ≈ Q A_old Qᵀ, so the
+// turned factor should age more slowly than the plain one. Vertices with a prescribed component
+// keep Q = I.
+class WarpedCholeskyCandidate final : public Candidate {
+ public:
+  void setup(const bench::StepSystem& s) override {
+    if (!factor_.factorize(s.a, &s.free)) throw std::runtime_error("warped: not positive definite");
+    x0_ = s.positions;
+    const Eigen::Index nv = s.a.rows() / 3;
+    neighbours_.assign(static_cast<std::size_t>(nv), {});
+    for (Eigen::Index col = 0; col < s.a.outerSize(); col += 3)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(s.a, col); it; ++it)
+        if (it.row() % 3 == 0 && it.row() != col) neighbours_[static_cast<std::size_t>(col / 3)].push_back(static_cast<int>(it.row() / 3));
+    q_.assign(static_cast<std::size_t>(nv), Eigen::Matrix3d::Identity());
+    whole_.assign(static_cast<std::size_t>(nv), 0);
+    for (Eigen::Index v = 0; v < nv; ++v) whole_[static_cast<std::size_t>(v)] = s.free[3 * v] && s.free[3 * v + 1] && s.free[3 * v + 2];
+  }
+  bool refresh(const bench::StepSystem& s) override {
+    const Eigen::Index nv = s.a.rows() / 3;
+    double worst = 0.0;
+    for (Eigen::Index v = 0; v < nv; ++v) {
+      if (!whole_[static_cast<std::size_t>(v)]) continue;
+      Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
+      const Eigen::Vector3d xv = s.positions.segment<3>(3 * v), Xv = x0_.segment<3>(3 * v);
+      for (int j : neighbours_[static_cast<std::size_t>(v)])
+        f += (s.positions.segment<3>(3 * j) - xv) * (x0_.segment<3>(3 * j) - Xv).transpose();
+      Eigen::JacobiSVD<Eigen::Matrix3d> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
+      Eigen::Matrix3d u = svd.matrixU();
+      if ((u * svd.matrixV().transpose()).determinant() < 0) u.col(2) = -u.col(2);
+      q_[static_cast<std::size_t>(v)] = u * svd.matrixV().transpose();
+      worst = std::max(worst, std::acos(std::clamp(0.5 * (q_[static_cast<std::size_t>(v)].trace() - 1.0), -1.0, 1.0)));
+    }
+    worst_turn_ = worst;
+    return true;
+  }
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) override {
+    const Eigen::Index nv = r.size() / 3;
+    t_.resize(r.size());
+    for (Eigen::Index v = 0; v < nv; ++v) t_.segment<3>(3 * v) = q_[static_cast<std::size_t>(v)].transpose() * r.segment<3>(3 * v);
+    factor_.apply(t_, u_);
+    z.resize(r.size());
+    for (Eigen::Index v = 0; v < nv; ++v) z.segment<3>(3 * v) = q_[static_cast<std::size_t>(v)] * u_.segment<3>(3 * v);
+  }
+  std::string info() const override {
+    std::ostringstream o;
+    o << "largest vertex turn " << worst_turn_ * 180.0 / M_PI << " deg";
+    return o.str();
+  }
+
+ private:
+  CholeskyPreconditioner factor_;
+  Eigen::VectorXd x0_, t_, u_;
+  std::vector<std::vector<int>> neighbours_;
+  std::vector<Eigen::Matrix3d> q_;
+  std::vector<char> whole_;
+  double worst_turn_ = 0.0;
 };
 
 class MultilevelCandidate final : public Candidate {
@@ -483,6 +547,7 @@ int run(int argc, char** argv) {
     std::unique_ptr<Candidate> c;
     if (name == "block_jacobi") c = std::make_unique<BlockJacobiCandidate>();
     else if (name == "cholesky") c = std::make_unique<CholeskyCandidate>();
+    else if (name == "warped") c = std::make_unique<WarpedCholeskyCandidate>();
     else if (name.rfind("mcm:", 0) == 0) {
       const std::string label = name.substr(4);
       if (!multilevel_options.count(label)) throw std::runtime_error("no --multilevel options for " + label);
