@@ -160,6 +160,15 @@ const std::map<std::string, Form>& forms() {
          "{python} {src}/scripts/scene_times.py table {tmp}/times.csv --before a --after b | grep -q '`sleeve_twist` | 2 |'"},
         "{python} {src}/scripts/scene_times.py --help",
         ""}},
+      // One small scene over 20 ms: the default tolerance passes; a tolerance far too loose (0.9)
+      // must fail with exit code 1.
+      {"scripts/tolerance_check.py run --csv OUT.csv",
+       {{"{python} {src}/scripts/tolerance_check.py run --csv {tmp}/tol.csv --bin {clothsim} --window 0.02 --only sleeve_gravity",
+         "{python} {src}/scripts/tolerance_check.py table {tmp}/tol.csv | grep -q '`sleeve_gravity` |.*| pass |'",
+         "{python} {src}/scripts/tolerance_check.py run --csv {tmp}/loose.csv --bin {clothsim} --window 0.02 "
+         "--only sleeve_gravity --tolerance 0.9 >/dev/null; test $? -eq 1 && grep -q ',FAIL,' {tmp}/loose.csv"},
+        "{python} {src}/scripts/tolerance_check.py --help",
+        "python:numpy"}},
       {"build/release/tools/check_intersections SURFACE.obj",
        {{"{clothsim} {src}/scenes/plate_ss.json --out {tmp}/ci --no-render",
          "{build}/tools/check_intersections {tmp}/ci/plate_ss/limit.obj"},
