@@ -1250,15 +1250,32 @@ struct ContactStage::Impl {
       // outer[3q + c] + 3 · (p's rank among q's coupled nodes).
       const int* outer_index = m.outerIndexPtr();
       std::vector<std::pair<int, Eigen::Matrix3d>> blocks;  // (node, B_k)
+      std::vector<std::pair<int, double>> weights;          // (node, w_k), node form
       for (const Row& r : rows) {
         if (r.passive()) continue;
         Eigen::Matrix3d hessian = r.friction_hessian;
         if (r.normal_active) hessian += r.kappa * r.normal * r.normal.transpose();
-        blocks.clear();
-        for (const auto& [node, w] : r.nodes) {
-          blocks.emplace_back(node, Eigen::Matrix3d::Zero());
-          blocks.back().second.diagonal().setConstant(w);
+        if (r.b.empty()) {
+          // The node form: Bₚᵀ H B_q = w_p w_q H. The nodes sorted, each node's ranks among the
+          // others' couplings are found by one merge instead of a search per pair.
+          weights.assign(r.nodes.begin(), r.nodes.end());
+          std::sort(weights.begin(), weights.end());
+          for (const auto& [q, wq] : weights) {
+            const Eigen::Matrix3d hq = hessian * wq;
+            const std::vector<int>& coupled = newton_pattern.adjacency[static_cast<size_t>(q)];
+            auto at = coupled.begin();
+            for (const auto& [p, wp] : weights) {
+              at = std::lower_bound(at, coupled.end(), p);
+              const int rank = static_cast<int>(at - coupled.begin());
+              for (int c = 0; c < 3; ++c) {
+                double* column = values + outer_index[3 * q + c] + 3 * rank;
+                for (int k = 0; k < 3; ++k) column[k] += wp * hq(k, c);
+              }
+            }
+          }
+          continue;
         }
+        blocks.clear();
         for (const auto& [dof, b] : r.b) {
           const int node = dof / 3;
           auto it = std::find_if(blocks.begin(), blocks.end(), [node](const auto& e) { return e.first == node; });
