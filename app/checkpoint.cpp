@@ -13,7 +13,7 @@ namespace {
 
 constexpr std::string_view kMagic = "clothsim checkpoint\n";
 constexpr std::string_view kEnd = "end\n";
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 2: RunTotals::contact_response_factorizations
 
 class Writer {
  public:

@@ -24,7 +24,7 @@ struct RunTotals {
   int frames = 0;
   int max_solver_iterations = 0;
   long long contact_pairs = 0, contact_impulses = 0, impact_zones = 0, contact_unresolved = 0;
-  long long contact_response_iterations = 0, contact_cg_iterations = 0;
+  long long contact_response_iterations = 0, contact_cg_iterations = 0, contact_response_factorizations = 0;
   double contact_ms = 0.0, contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;
 };
 

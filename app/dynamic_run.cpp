@@ -200,7 +200,8 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                     {"narrow_phase_seconds", totals.contact_narrow_ms / 1000.0},
                     {"response_seconds", totals.contact_response_ms / 1000.0},
                     {"response_iterations", totals.contact_response_iterations},
-                    {"response_cg_iterations", totals.contact_cg_iterations}};
+                    {"response_cg_iterations", totals.contact_cg_iterations},
+                    {"response_factorizations", totals.contact_response_factorizations}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -215,7 +216,7 @@ class Outputs {
     if (resume) return;
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms") +
-                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations" : ""));
+                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations" : ""));
     probes_.flush();
     stats_.flush();
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
@@ -297,7 +298,7 @@ class Outputs {
       for (const std::string& field : {std::to_string(s.contact_pairs), std::to_string(s.contact_impulses),
                                        std::to_string(s.impact_zones), std::to_string(s.contact_unresolved),
                                        format_double(s.contact_ms), std::to_string(s.contact_response_iterations),
-                                       std::to_string(s.contact_cg_iterations)})
+                                       std::to_string(s.contact_cg_iterations), std::to_string(s.contact_response_factorizations)})
         row.append(1, ',').append(field);
     stats_.line(row);  // flushed by record_state, together with the probes
   }
@@ -631,6 +632,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
           totals.contact_response_ms += s.contact_response_ms;
           totals.contact_response_iterations += s.contact_response_iterations;
           totals.contact_cg_iterations += s.contact_cg_iterations;
+          totals.contact_response_factorizations += s.contact_response_factorizations;
           const int frames_before = totals.frames;
           outputs->record_stats(s);
           outputs->record_state(*sim, s.step, s.t, totals);

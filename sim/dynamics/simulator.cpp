@@ -38,6 +38,7 @@ class ContactFilter final : public VelocityFilter {
     stats.contact_response_ms += r.response_ms;
     stats.contact_response_iterations += r.response_iterations;
     stats.contact_cg_iterations += r.response_cg_iterations;
+    stats.contact_response_factorizations += r.response_factorizations;
   }
 
  private:

@@ -82,6 +82,7 @@ struct StepStats {
   double contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;  // its phases
   int contact_response_iterations = 0;   // augmented-Lagrangian updates of the implicit response
   long long contact_cg_iterations = 0;   // conjugate-gradient iterations in them
+  int contact_response_factorizations = 0;  // Cholesky factorisations of the response's Newton matrix
 };
 
 // The step's linear system as the solve left it, for a velocity filter that responds implicitly:

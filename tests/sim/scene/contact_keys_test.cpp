@@ -538,7 +538,7 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
     return line;
   };
   const std::string contact_columns =
-      ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations";
+      ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations";
   const std::string header_with = first_line(out() / "touch" / "stats.csv");
   const std::string header_without = first_line(out() / "free" / "stats.csv");
   EXPECT_EQ(header_with.size() >= contact_columns.size() &&
@@ -553,7 +553,7 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
   ASSERT_TRUE(sa.contains("contact")) << sa.dump();
   for (const char* key : {"pairs_tested", "impulses", "impact_zones", "unresolved_pairs", "seconds",
                           "broad_phase_seconds", "narrow_phase_seconds", "response_seconds", "response_iterations",
-                          "response_cg_iterations"})
+                          "response_cg_iterations", "response_factorizations"})
     EXPECT_TRUE(sa["contact"].contains(key)) << key << ": " << sa.dump();
   EXPECT_GT(sa["contact"]["pairs_tested"].get<long long>(), 0);  // the cloth starts within the thickness
   EXPECT_FALSE(sb.contains("contact")) << sb.dump();
