@@ -18,10 +18,12 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 #include <string>
@@ -507,6 +509,42 @@ TEST_F(ContactKeysCli, BadContactKeysWriteNothing) {
     EXPECT_TRUE(contains(r.err, "clothsim: error: " + scene.string() + ": " + cases[i].second))
         << "expected \"" << cases[i].second << "\" in: " << r.err;
     EXPECT_FALSE(fs::exists(out())) << "output root created for " << cases[i].second;
+  }
+}
+
+// The implicit response's figures in summary.json are the sums of their stats.csv columns, on a
+// run whose response refactorises its Newton matrix (a sheet pressed onto the ground with
+// friction and self-collision on).
+TEST_F(ContactKeysCli, ResponseFiguresSumTheirColumns) {
+  const fs::path scene = write("press.json", R"({"name": "press", "analysis": "dynamic",
+      "mesh": {"primitive": "grid", "size": [0.2, 0.2], "divisions": [8, 8],
+               "rotate": {"axis": [1, 0, 0], "angle_deg": -90}, "translate": [0, 0.0015, 0]},
+      "material": {"preset": "cotton"},
+      "loads": {"gravity": [0, -9.81, 0]},
+      "time": {"dt": 0.001, "end": 0.004, "output_fps": 500},
+      "collision": {"thickness": 0.002, "friction": 0.5, "self": true},
+      "obstacles": [{"name": "ground", "primitive": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}]})");
+  const RunResult r = run_scene(scene, "--no-render");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::string> keys = {"response_iterations", "response_cg_iterations", "response_factorizations"};
+  std::istringstream in(clothsim::testing::read_file_bytes(out() / "press" / "stats.csv"));
+  std::string field;
+  std::getline(in, field);
+  std::vector<std::string> names;
+  for (std::istringstream header(field); std::getline(header, field, ',');) names.push_back(field);
+  std::map<std::string, long long> sums;
+  int rows = 0;
+  for (std::string row; std::getline(in, row); ++rows) {
+    std::istringstream fields(row);
+    for (std::size_t k = 0; k < names.size() && std::getline(fields, field, ','); ++k)
+      if (std::find(keys.begin(), keys.end(), names[k]) != keys.end()) sums[names[k]] += std::stoll(field);
+  }
+  EXPECT_EQ(rows, 4);
+  const nlohmann::json summary = nlohmann::json::parse(clothsim::testing::read_file_bytes(out() / "press" / "summary.json"));
+  for (const std::string& key : keys) {
+    EXPECT_EQ(sums.count(key), 1u) << key << " is not a column of stats.csv";
+    EXPECT_EQ(sums[key], summary["contact"][key].get<long long>()) << key;
+    EXPECT_GT(sums[key], 0) << key;  // the cloth is pressed onto the ground: the response works
   }
 }
 
