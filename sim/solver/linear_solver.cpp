@@ -48,14 +48,37 @@ LinearSolverSettings resolve_automatic(const LinearSolverSettings& settings, Eig
 }
 
 struct LinearSolver::Impl {
-  DirectSolver direct;             // type "cholmod"
-  CholeskyPreconditioner factor;   // "pcg" with the "cholesky" preconditioner
+  std::unique_ptr<DirectSolver> direct;             // type "cholmod"
+  std::unique_ptr<CholeskyPreconditioner> factor;   // "pcg" with the "cholesky" preconditioner
+  bool supernodal = false;
+  // The pattern the factorisations were analysed for (outer and inner indices): a system with
+  // another pattern (a step potential's couplings, sim/solver/coupled_matrix.hpp) needs a new
+  // analysis, so both factorisations are made anew for it.
+  std::vector<int> outer, inner;
+  bool same_pattern(const Eigen::SparseMatrix<double>& a) const {
+    return static_cast<Eigen::Index>(outer.size()) == a.outerSize() + 1 &&
+           static_cast<Eigen::Index>(inner.size()) == a.nonZeros() &&
+           std::equal(outer.begin(), outer.end(), a.outerIndexPtr()) &&
+           std::equal(inner.begin(), inner.end(), a.innerIndexPtr());
+  }
+  // Starts afresh for a's pattern when it is not the one analysed; returns whether it was new.
+  bool adopt_pattern(const Eigen::SparseMatrix<double>& a) {
+    if (same_pattern(a)) return false;
+    outer.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1);
+    inner.assign(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros());
+    direct = std::make_unique<DirectSolver>(supernodal);
+    factor = std::make_unique<CholeskyPreconditioner>();
+    return true;
+  }
   // When to refresh `factor` (counted in conjugate-gradient iterations, see solve()).
   int solves_since_factor = 0;
   double iterations_since_factor = 0.0;
   bool refactor_next = false;
   Eigen::VectorXd factored_values;  // of the matrix last factorised for the preconditioner (checkpoints)
-  explicit Impl(bool supernodal) : direct(supernodal) {}
+  explicit Impl(bool supernodal_factor)
+      : direct(std::make_unique<DirectSolver>(supernodal_factor)),
+        factor(std::make_unique<CholeskyPreconditioner>()),
+        supernodal(supernodal_factor) {}
 };
 
 LinearSolver::LinearSolver(const LinearSolverSettings& settings, Eigen::Index size)
@@ -68,9 +91,11 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
   Impl& m = *impl_;
   const LinearSolverSettings& s = settings_;
   LinearSolveReport report;
+  if (!a.isCompressed()) throw std::invalid_argument("LinearSolver::solve: the matrix must be compressed");
+  if (m.adopt_pattern(a)) m.refactor_next = false;  // (a new factor is made below)
   auto refactor = [&] {
     const auto f0 = std::chrono::steady_clock::now();
-    m.factor.factorize(a, &free);  // of the Dirichlet form
+    m.factor->factorize(a, &free);  // of the Dirichlet form
     m.factored_values = Eigen::Map<const Eigen::VectorXd>(a.valuePtr(), a.nonZeros());
     ++report.factorizations;
     report.factor_ms += ms_since(f0);
@@ -89,14 +114,14 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
       if (!free[i]) b(i) = fixed_values(i);
     set_dirichlet_identity(a, free);
     const auto f0 = std::chrono::steady_clock::now();
-    const bool factored = m.direct.refactorize(a);
+    const bool factored = m.direct->refactorize(a);
     ++report.factorizations;
     report.factor_ms += ms_since(f0);
     if (!factored) {
       report.failure = "the system matrix is not positive definite (CHOLMOD)";
       return report;
     }
-    x = m.direct.solve(b);
+    x = m.direct->solve(b);
     report.iterations = 1;
     report.residual = (a * x - b).norm() / std::max(b.norm(), 1e-300);
     report.converged = true;
@@ -104,16 +129,16 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
   }
 
   const bool cholesky = s.preconditioner == PreconditionerType::cholesky;
-  if (cholesky && (!m.factor.ready() || m.refactor_next)) {
+  if (cholesky && (!m.factor->ready() || m.refactor_next)) {
     m.refactor_next = false;
     refactor();
   }
-  const Preconditioner factor = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor.apply(r, z); };
+  const Preconditioner factor = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor->apply(r, z); };
   const Eigen::VectorXd start = x;
   // With a stale factor a solve is cut off after 3 × refresh_iterations (a fresh factor is cheaper
   // than that) and, below, refactorised and solved again.
-  const int first_limit = cholesky && m.factor.ready() ? std::min(s.max_iterations, 3 * s.refresh_iterations) : s.max_iterations;
-  PcgResult r = solve_pcg(a, b, free, x, s.tolerance, first_limit, cholesky && m.factor.ready() ? factor : Preconditioner());
+  const int first_limit = cholesky && m.factor->ready() ? std::min(s.max_iterations, 3 * s.refresh_iterations) : s.max_iterations;
+  PcgResult r = solve_pcg(a, b, free, x, s.tolerance, first_limit, cholesky && m.factor->ready() ? factor : Preconditioner());
   if (cholesky) {
     // The factor is of an earlier matrix, and the iterations grow as the matrix drifts from it
     // (about one more per step in the buckling sleeve). Refactor when this solve cost more than
@@ -131,12 +156,12 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
     // Decided on counts, never on timings: runs are repeatable.
     ++m.solves_since_factor;
     m.iterations_since_factor += r.iterations;
-    const double iteration_work = 4.0 * static_cast<double>(m.factor.factor_entries()) + 2.0 * static_cast<double>(a.nonZeros());
-    const double factor_cost = 0.17 * m.factor.factor_flops() / std::max(iteration_work, 1.0);
+    const double iteration_work = 4.0 * static_cast<double>(m.factor->factor_entries()) + 2.0 * static_cast<double>(a.nonZeros());
+    const double factor_cost = 0.17 * m.factor->factor_flops() / std::max(iteration_work, 1.0);
     const bool pays = r.iterations * m.solves_since_factor > factor_cost + m.iterations_since_factor;
     if (!r.converged) {  // refactor now and solve again from the same start
       refactor();
-      if (m.factor.ready()) {
+      if (m.factor->ready()) {
         report.iterations += r.iterations;
         x = start;
         r = solve_pcg(a, b, free, x, s.tolerance, std::max(1, s.max_iterations - report.iterations), factor);
@@ -161,7 +186,7 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
 LinearSolverCheckpoint LinearSolver::checkpoint() const {
   const Impl& m = *impl_;
   LinearSolverCheckpoint c;
-  if (m.factor.ready()) c.factored_values = m.factored_values;
+  if (m.factor->ready()) c.factored_values = m.factored_values;
   c.solves_since_factor = m.solves_since_factor;
   c.iterations_since_factor = m.iterations_since_factor;
   c.refactor_next = m.refactor_next;
@@ -179,7 +204,8 @@ void LinearSolver::restore(const LinearSolverCheckpoint& c, const Eigen::SparseM
       throw std::invalid_argument("LinearSolver::restore: a factor for a solver without the Cholesky preconditioner");
     Eigen::SparseMatrix<double> a = pattern;
     Eigen::Map<Eigen::VectorXd>(a.valuePtr(), a.nonZeros()) = c.factored_values;
-    m.factor.factorize(a, &free);
+    m.adopt_pattern(a);
+    m.factor->factorize(a, &free);
     m.factored_values = c.factored_values;
   }
   m.solves_since_factor = c.solves_since_factor;
@@ -190,9 +216,9 @@ void LinearSolver::restore(const LinearSolverCheckpoint& c, const Eigen::SparseM
 Preconditioner LinearSolver::preconditioner(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free) const {
   const Impl& m = *impl_;
   if (settings_.type == LinearSolverType::cholmod)
-    return [&m](const Eigen::VectorXd& r, Eigen::VectorXd& z) { z = m.direct.solve(r); };
-  if (settings_.preconditioner == PreconditionerType::cholesky && m.factor.ready())
-    return [&m](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor.apply(r, z); };
+    return [&m](const Eigen::VectorXd& r, Eigen::VectorXd& z) { z = m.direct->solve(r); };
+  if (settings_.preconditioner == PreconditionerType::cholesky && m.factor->ready())
+    return [&m](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor->apply(r, z); };
   return block_jacobi(a, free);
 }
 

@@ -1,0 +1,160 @@
+#include "sim/solver/coupled_matrix.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace clothsim {
+
+std::vector<int> NodeRow::node_list() const {
+  std::vector<int> out;
+  out.reserve(nodes.size() + dofs.size());
+  for (const auto& entry : nodes) out.push_back(entry.first);
+  for (const auto& entry : dofs) out.push_back(entry.first / 3);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+bool CoupledMatrix::covers(const Eigen::SparseMatrix<double>& a, const std::vector<std::vector<int>>& groups) const {
+  if (matrix_.rows() != a.rows() || a_entries_ != a.nonZeros()) return false;
+  for (const std::vector<int>& nodes : groups)
+    for (int p : nodes) {
+      const std::vector<int>& row = adjacency_[static_cast<size_t>(p)];
+      auto at = row.begin();
+      for (int q : nodes) {  // both sorted: one merge
+        at = std::lower_bound(at, row.end(), q);
+        if (at == row.end() || *at != q) return false;
+      }
+    }
+  return true;
+}
+
+void CoupledMatrix::rebuild(const Eigen::SparseMatrix<double>& a, const std::vector<std::vector<int>>& groups, bool keep_previous) {
+  const Eigen::Index num_nodes = a.cols() / 3;
+  const bool keep = keep_previous && matrix_.rows() == a.rows() && a_entries_ == a.nonZeros() &&
+                    matrix_.nonZeros() <= 2 * a.nonZeros();
+  if (!keep) adjacency_.assign(static_cast<size_t>(num_nodes), {});
+  for (Eigen::Index col = 0; col < a.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it)
+      adjacency_[static_cast<size_t>(col / 3)].push_back(static_cast<int>(it.row() / 3));
+  for (const std::vector<int>& nodes : groups)
+    for (int p : nodes) adjacency_[static_cast<size_t>(p)].insert(adjacency_[static_cast<size_t>(p)].end(), nodes.begin(), nodes.end());
+  for (std::vector<int>& row : adjacency_) {
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+  }
+  build_from_adjacency(a);
+}
+
+void CoupledMatrix::restore(const Eigen::SparseMatrix<double>& a, const std::vector<std::vector<int>>& adjacency) {
+  if (static_cast<Eigen::Index>(adjacency.size()) != a.cols() / 3)
+    throw std::invalid_argument("CoupledMatrix::restore: the saved pattern does not fit the matrix");
+  adjacency_ = adjacency;
+  for (std::vector<int>& row : adjacency_) {
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+  }
+  // A's couplings must be there too (they are in any adjacency a rebuild made).
+  for (Eigen::Index col = 0; col < a.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
+      const std::vector<int>& row = adjacency_[static_cast<size_t>(col / 3)];
+      if (!std::binary_search(row.begin(), row.end(), static_cast<int>(it.row() / 3)))
+        throw std::invalid_argument("CoupledMatrix::restore: the saved pattern lacks a coupling of the matrix");
+    }
+  build_from_adjacency(a);
+}
+
+void CoupledMatrix::clear() {
+  matrix_ = Eigen::SparseMatrix<double>();
+  a_entries_ = -1;
+  from_a_.clear();
+  adjacency_.clear();
+}
+
+void CoupledMatrix::build_from_adjacency(const Eigen::SparseMatrix<double>& a) {
+  // Column 3p + j holds, for each coupled node q (ascending), the rows 3q, 3q + 1, 3q + 2.
+  const Eigen::Index n3 = a.rows();
+  std::vector<int> outer(static_cast<size_t>(n3) + 1, 0);
+  for (size_t p = 0; p < adjacency_.size(); ++p)
+    for (int j = 0; j < 3; ++j) outer[3 * p + static_cast<size_t>(j) + 1] = 3 * static_cast<int>(adjacency_[p].size());
+  for (size_t c = 0; c < static_cast<size_t>(n3); ++c) outer[c + 1] += outer[c];
+  matrix_.resize(n3, n3);
+  matrix_.resizeNonZeros(outer.back());
+  std::copy(outer.begin(), outer.end(), matrix_.outerIndexPtr());
+  int* inner = matrix_.innerIndexPtr();
+  for (size_t p = 0; p < adjacency_.size(); ++p)
+    for (int j = 0; j < 3; ++j) {
+      int at = outer[3 * p + static_cast<size_t>(j)];
+      for (int q : adjacency_[p])
+        for (int i = 0; i < 3; ++i) inner[at++] = 3 * q + i;
+    }
+  std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+  a_entries_ = a.nonZeros();
+  from_a_.assign(static_cast<size_t>(a.nonZeros()), 0);
+  for (Eigen::Index col = 0; col < a.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
+      const int* first = inner + outer[static_cast<size_t>(col)];
+      const int* last = inner + outer[static_cast<size_t>(col) + 1];
+      from_a_[static_cast<size_t>(&it.valueRef() - a.valuePtr())] =
+          static_cast<int>(std::lower_bound(first, last, static_cast<int>(it.row())) - inner);
+    }
+}
+
+void CoupledMatrix::set_base(const Eigen::SparseMatrix<double>& a) {
+  if (a.nonZeros() != a_entries_) throw std::logic_error("CoupledMatrix::set_base: the matrix's pattern changed");
+  double* values = matrix_.valuePtr();
+  std::fill(values, values + matrix_.nonZeros(), 0.0);
+  const double* av = a.valuePtr();
+  for (Eigen::Index k = 0; k < a.nonZeros(); ++k) values[from_a_[static_cast<size_t>(k)]] += av[k];
+}
+
+void CoupledMatrix::add_block(const NodeRow& row, const Eigen::Matrix3d& h) {
+  double* values = matrix_.valuePtr();
+  const int* outer = matrix_.outerIndexPtr();
+  if (row.dofs.empty()) {
+    // Node form: Bₚᵀ H B_q = w_p w_q H. With the nodes sorted, each node's ranks among the
+    // others' couplings are found by one merge.
+    std::vector<std::pair<int, double>> weights(row.nodes.begin(), row.nodes.end());
+    std::sort(weights.begin(), weights.end());
+    for (const auto& [q, wq] : weights) {
+      const Eigen::Matrix3d hq = h * wq;
+      const std::vector<int>& coupled = adjacency_[static_cast<size_t>(q)];
+      auto at = coupled.begin();
+      for (const auto& [p, wp] : weights) {
+        at = std::lower_bound(at, coupled.end(), p);
+        const int rank = static_cast<int>(at - coupled.begin());
+        for (int c = 0; c < 3; ++c) {
+          double* column = values + outer[3 * q + c] + 3 * rank;
+          for (int k = 0; k < 3; ++k) column[k] += wp * hq(k, c);
+        }
+      }
+    }
+    return;
+  }
+  // Per DOF: gather the 3 × 3 block B_k of each node, then Bₚᵀ H B_q.
+  std::vector<std::pair<int, Eigen::Matrix3d>> blocks;
+  for (const auto& [node, w] : row.nodes) blocks.emplace_back(node, w * Eigen::Matrix3d::Identity());
+  for (const auto& [dof, b] : row.dofs) {
+    const int node = dof / 3;
+    auto it = std::find_if(blocks.begin(), blocks.end(), [node](const auto& e) { return e.first == node; });
+    if (it == blocks.end()) {
+      blocks.emplace_back(node, Eigen::Matrix3d::Zero());
+      it = blocks.end() - 1;
+    }
+    it->second.col(dof % 3) += b;
+  }
+  for (const auto& [q, bq] : blocks) {
+    const Eigen::Matrix3d hbq = h * bq;
+    const std::vector<int>& coupled = adjacency_[static_cast<size_t>(q)];
+    for (const auto& [p, bp] : blocks) {
+      const int rank = static_cast<int>(std::lower_bound(coupled.begin(), coupled.end(), p) - coupled.begin());
+      const Eigen::Matrix3d block = bp.transpose() * hbq;
+      for (int c = 0; c < 3; ++c) {
+        double* column = values + outer[3 * q + c] + 3 * rank;
+        for (int k = 0; k < 3; ++k) column[k] += block(k, c);
+      }
+    }
+  }
+}
+
+}  // namespace clothsim
