@@ -13,7 +13,7 @@ namespace {
 
 constexpr std::string_view kMagic = "clothsim checkpoint\n";
 constexpr std::string_view kEnd = "end\n";
-constexpr std::uint32_t kVersion = 2;  // 2: RunTotals::contact_response_factorizations
+constexpr std::uint32_t kVersion = 3;  // 2: RunTotals::contact_response_factorizations; 3: the coupled pattern
 
 class Writer {
  public:
@@ -81,6 +81,28 @@ std::uint64_t fnv1a(std::string_view data, std::uint64_t hash) {
   return hash;
 }
 
+// A pattern (per node, its coupled nodes) as one vector: per node its count, then the nodes.
+Eigen::VectorXd flatten(const std::vector<std::vector<int>>& pattern) {
+  std::vector<double> out;
+  for (const std::vector<int>& row : pattern) {
+    out.push_back(static_cast<double>(row.size()));
+    out.insert(out.end(), row.begin(), row.end());
+  }
+  return Eigen::Map<const Eigen::VectorXd>(out.data(), static_cast<Eigen::Index>(out.size()));
+}
+
+std::vector<std::vector<int>> unflatten(const Eigen::VectorXd& flat, Reader& r) {
+  std::vector<std::vector<int>> pattern;
+  for (Eigen::Index at = 0; at < flat.size();) {
+    const double count = flat(at++);
+    if (!(count >= 0) || count > static_cast<double>(flat.size() - at)) r.fail("a coupled pattern that does not add up");
+    std::vector<int> row;
+    for (Eigen::Index k = 0; k < static_cast<Eigen::Index>(count); ++k) row.push_back(static_cast<int>(flat(at++)));
+    pattern.push_back(std::move(row));
+  }
+  return pattern;
+}
+
 void write_checkpoint(const std::filesystem::path& path, const RunCheckpoint& c) {
   Writer w;
   w.text(kMagic);
@@ -96,6 +118,7 @@ void write_checkpoint(const std::filesystem::path& path, const RunCheckpoint& c)
   w.put(s.integrator.v_previous);
   w.put(s.integrator.external_work);
   w.put(s.integrator.boundary_work);
+  w.put(flatten(s.integrator.coupled_pattern));
   w.put(s.solver.factored_values);
   w.put(static_cast<std::int64_t>(s.solver.solves_since_factor));
   w.put(s.solver.iterations_since_factor);
@@ -129,6 +152,7 @@ RunCheckpoint read_checkpoint(const std::filesystem::path& path) {
   s.integrator.v_previous = r.vector();
   s.integrator.external_work = r.get<double>();
   s.integrator.boundary_work = r.get<double>();
+  s.integrator.coupled_pattern = unflatten(r.vector(), r);
   s.solver.factored_values = r.vector();
   s.solver.solves_since_factor = static_cast<int>(r.get<std::int64_t>());
   s.solver.iterations_since_factor = r.get<double>();

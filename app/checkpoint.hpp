@@ -26,6 +26,8 @@ struct RunTotals {
   long long contact_pairs = 0, contact_impulses = 0, impact_zones = 0, contact_unresolved = 0;
   long long contact_response_iterations = 0, contact_cg_iterations = 0, contact_response_factorizations = 0;
   double contact_ms = 0.0, contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;
+  long long contact_newton_iterations = 0;  // linear solves of steps with the contact barrier
+  double contact_potential_ms = 0.0;        // evaluating the barrier (part of contact_ms)
 };
 
 struct RunCheckpoint {

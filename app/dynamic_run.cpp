@@ -201,7 +201,10 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                     {"response_seconds", totals.contact_response_ms / 1000.0},
                     {"response_iterations", totals.contact_response_iterations},
                     {"response_cg_iterations", totals.contact_cg_iterations},
-                    {"response_factorizations", totals.contact_response_factorizations}};
+                    {"response_factorizations", totals.contact_response_factorizations},
+                    {"method", scene.problem.collision.barrier ? "barrier" : "constraints"},
+                    {"barrier_seconds", totals.contact_potential_ms / 1000.0},
+                    {"newton_iterations", totals.contact_newton_iterations}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -216,7 +219,7 @@ class Outputs {
     if (resume) return;
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms") +
-                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations" : ""));
+                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy" : ""));
     probes_.flush();
     stats_.flush();
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
@@ -298,7 +301,9 @@ class Outputs {
       for (const std::string& field : {std::to_string(s.contact_pairs), std::to_string(s.contact_impulses),
                                        std::to_string(s.impact_zones), std::to_string(s.contact_unresolved),
                                        format_double(s.contact_ms), std::to_string(s.contact_response_iterations),
-                                       std::to_string(s.contact_cg_iterations), std::to_string(s.contact_response_factorizations)})
+                                       std::to_string(s.contact_cg_iterations), std::to_string(s.contact_response_factorizations),
+                                       std::to_string(s.contact_newton_iterations), std::to_string(s.contact_active_pairs),
+                                       format_double(s.contact_energy)})
         row.append(1, ',').append(field);
     stats_.line(row);  // flushed by record_state, together with the probes
   }
@@ -633,6 +638,8 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
           totals.contact_response_iterations += s.contact_response_iterations;
           totals.contact_cg_iterations += s.contact_cg_iterations;
           totals.contact_response_factorizations += s.contact_response_factorizations;
+          totals.contact_newton_iterations += s.contact_newton_iterations;
+          totals.contact_potential_ms += s.contact_potential_ms;
           const int frames_before = totals.frames;
           outputs->record_stats(s);
           outputs->record_state(*sim, s.step, s.t, totals);

@@ -1,5 +1,6 @@
 #include "sim/contact/contact_stage.hpp"
 
+#include "sim/contact/barrier.hpp"
 #include "sim/contact/narrow_phase.hpp"
 #include "sim/solver/cholesky_preconditioner.hpp"
 
@@ -564,7 +565,7 @@ struct ContactStage::Impl {
   std::vector<Candidate> candidates(ContactReport& report) {
     const auto t0 = Clock::now();
     std::vector<Candidate> out;
-    const double grow = settings.thickness;
+    const double grow = candidate_grow > 0 ? candidate_grow : settings.thickness;
     // Swept boxes: triangles grown by the thickness (for the broad phase), and exact ones of the
     // triangles, points (grown by the thickness) and edges (grown by half of it) to cull the
     // pairs a triangle pair stands for.
@@ -1464,6 +1465,298 @@ struct ContactStage::Impl {
     report.response_ms += ms_since(t0);
   }
 
+  // --- The potential inside the step (docs/contact.md, "Contact inside the step") ---------------
+  bool potential_on = false;
+  double potential_t = 0.0;
+  double candidate_grow = 0.0;              // > 0: the broad phase's growth instead of the thickness [m]
+  std::vector<Candidate> potential_cands;   // this step's candidates (boxes grown by 2 d̂)
+  Eigen::MatrixX3d potential_guess;         // the end points they were made for
+  std::vector<double> cand_stiffness;       // the barrier's k per candidate [N/m]
+  std::vector<double> plane_stiffness;      // per surface point, against planes [N/m]
+  Eigen::VectorXd point_mass;               // per surface point: 1 / Σ_k J_k² / s_k [kg]
+  struct FrictionRow {
+    NodeRow row;
+    Eigen::Vector3d constant = Eigen::Vector3d::Zero();  // the obstacle side's part of u [m/s]
+    Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity();
+    double bound = 0.0;  // μ λ [N]
+  };
+  std::vector<FrictionRow> friction_rows;
+  double potential_ms = 0.0;
+  std::map<std::pair<int, int>, size_t> closest;  // scratch: (cloth point, obstacle) -> candidate
+
+  double barrier_ratio() const { return params.barrier_ratio; }
+
+  // The constraint's row over the DOFs in node form where it has that shape (NodeRow).
+  NodeRow node_row(const Constraint& c) {
+    NodeRow row;
+    row.dofs = c.b;
+    to_node_form(row.dofs, row.nodes);
+    return row;
+  }
+
+  // The barrier's stiffness for a pair of cloth points: k h² = ratio × the smallest effective
+  // mass (with the step's stiffness, s_k) of its cloth points, so the barrier is as stiff as the
+  // step's own system is under it, whatever the material and step.
+  double pair_stiffness(const Candidate& c) const {
+    double m = std::numeric_limits<double>::infinity();
+    for (int p : cloth_points_of(c))
+      if (p >= 0) m = std::min(m, point_mass(p));
+    return barrier_ratio() * m / (h * h);
+  }
+
+  // The potential's candidates: the broad phase over the motion p0 → p1 with boxes grown by twice
+  // the thickness. They serve every motion whose start and end points (and obstacle vertices)
+  // each stay within half the thickness of the ones they were made for: at any time of such a
+  // motion every point is within that of the old one, so each pair that comes within the
+  // thickness at the end (the barrier) or within the thickness over the step (the fail-safe's
+  // CCD) is among them. So they are kept from step to step while the cloth moves little (a
+  // resting drape), and made again when it moves on.
+  Eigen::MatrixX3d built_p0, built_o0, built_o1;  // the motion they were made for (and potential_guess)
+  static double largest_move(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+    if (a.rows() != b.rows()) return std::numeric_limits<double>::infinity();
+    return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
+  }
+  bool candidates_serve() const {
+    const double half = 0.5 * settings.thickness;
+    return largest_move(p0, built_p0) <= half && largest_move(p1, potential_guess) <= half &&
+           largest_move(o0, built_o0) <= half && largest_move(o1, built_o1) <= half;
+  }
+  void make_potential_candidates(ContactReport& report) {
+    candidate_grow = 2.0 * settings.thickness;
+    potential_cands = candidates(report);
+    candidate_grow = 0.0;
+    potential_guess = p1;
+    built_p0 = p0;
+    built_o0 = o0;
+    built_o1 = o1;
+    prepare_candidates();
+  }
+  // Per step (and after a new broad phase): each candidate's barrier stiffness and geometry at
+  // the start of the step.
+  void prepare_candidates() {
+    cand_stiffness.resize(potential_cands.size());
+    for (size_t i = 0; i < potential_cands.size(); ++i) cand_stiffness[i] = pair_stiffness(potential_cands[i]);
+    // Each pair's geometry at the start of the step: its side (the barrier's distance is signed
+    // by it, see linearise_potential) and, for pairs pressed at the start, lagged friction.
+    cand_start.resize(potential_cands.size());
+    cand_start_close.assign(potential_cands.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Candidate& c = potential_cands[i];
+        if (c.near) continue;
+        const std::array<Eigen::Vector3d, 4> corner = corners(c, false);
+        cand_start[i] = geometry(c, corner);
+        cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face(c, cand_start[i], corner);
+      }
+    });
+  }
+  // Of the flagged cloth-point–obstacle-triangle candidates, keeps (flagged) the closest triangle
+  // per point and obstacle.
+  void keep_closest(std::vector<char>& flagged, const std::vector<PairGeometry>& geometry_of) {
+    closest.clear();
+    for (size_t i = 0; i < potential_cands.size(); ++i) {
+      const Candidate& c = potential_cands[i];
+      if (!flagged[i] || c.kind != Kind::cloth_point_obstacle_triangle) continue;
+      const int obstacle = obstacle_of_vertex[static_cast<size_t>(obstacle_triangles[static_cast<size_t>(c.b)][0])];
+      auto [it, inserted] = closest.emplace(std::pair{c.a, obstacle}, i);
+      if (inserted) continue;
+      size_t& best = it->second;
+      if (geometry_of[i].distance < geometry_of[best].distance) {
+        flagged[best] = 0;
+        best = i;
+      } else {
+        flagged[i] = 0;
+      }
+    }
+  }
+
+  std::vector<PairGeometry> cand_start;  // per candidate, at the start of the step
+  std::vector<char> cand_start_close;    // ... within the thickness there
+
+  // Whether the two primitives of a pair (a point and a triangle's corners, or two edges' end
+  // points) have boxes closer than `reach` in every axis: otherwise their distance is at least that.
+  static bool within_boxes(const std::array<Eigen::Vector3d, 4>& x, bool point_triangle, double reach) {
+    Eigen::Vector3d lo_a = x[0], hi_a = x[0], lo_b, hi_b;
+    if (point_triangle) {
+      lo_b = x[1].cwiseMin(x[2]).cwiseMin(x[3]);
+      hi_b = x[1].cwiseMax(x[2]).cwiseMax(x[3]);
+    } else {
+      lo_a = x[0].cwiseMin(x[1]);
+      hi_a = x[0].cwiseMax(x[1]);
+      lo_b = x[2].cwiseMin(x[3]);
+      hi_b = x[2].cwiseMax(x[3]);
+    }
+    return ((lo_a.array() - reach) <= hi_b.array()).all() && ((lo_b.array() - reach) <= hi_a.array()).all();
+  }
+
+  // The pair's distance signed by the side it started on: a pair whose closest points are inside
+  // both primitives (a point over a triangle's interior, two edges at interior points) and whose
+  // normal turned against its normal at the start of the step has passed through: its distance is
+  // negative and its normal the start side's, so the barrier pushes it back rather than through.
+  // (Where a closest point is on a primitive's boundary the normal can turn round an edge without
+  // a crossing; there the distance stays unsigned.)
+  static void sign_by_start(const Candidate& c, const PairGeometry& start, PairGeometry& end, bool point_triangle) {
+    if (!(end.normal.dot(start.normal) < 0)) return;
+    bool interior;
+    if (point_triangle) {
+      interior = -end.coef[1] > 0 && -end.coef[2] > 0 && -end.coef[3] > 0;
+    } else {
+      interior = end.coef[1] > 0 && end.coef[0] > 0 && end.coef[3] < 0 && end.coef[2] < 0;
+    }
+    (void)c;
+    if (!interior) return;
+    end.distance = -end.distance;
+    end.normal = -end.normal;
+  }
+
+  void begin_potential(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double step,
+                       const Eigen::VectorXd& diagonal) {
+    const auto t0 = Clock::now();
+    potential_ms = 0.0;
+    h = step;
+    start_positions(x, t);
+    end_points_current = false;
+    update_end_points(v_guess);
+    // Effective masses of the surface points through J, with each node's scale s_k the mean of
+    // its three diagonal entries of A (a rotation leaves the trace of a node's block unchanged).
+    Eigen::VectorXd scale(d.num_nodes());
+    for (int k = 0; k < d.num_nodes(); ++k) scale(k) = diagonal.segment<3>(3 * k).sum() / 3.0;
+    point_mass.resize(p0.rows());
+    for (Eigen::Index p = 0; p < p0.rows(); ++p) {
+      double sum = 0.0;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(jacobian, 3 * p); it; ++it)
+        sum += it.value() * it.value() / scale(it.col() / 3);
+      point_mass(p) = sum > 0 ? 1.0 / sum : std::numeric_limits<double>::infinity();
+    }
+    plane_stiffness.resize(static_cast<size_t>(p0.rows()));
+    for (Eigen::Index p = 0; p < p0.rows(); ++p) plane_stiffness[static_cast<size_t>(p)] = barrier_ratio() * point_mass(p) / (h * h);
+    ContactReport scratch;
+    if (candidates_serve()) {
+      prepare_candidates();
+    } else {
+      make_potential_candidates(scratch);
+    }
+    // Lagged friction: the pairs pressed at the start of the step, with their normal force and
+    // tangent plane there (fixed over the step, so the friction potential is convex in v).
+    friction_rows.clear();
+    keep_closest(cand_start_close, cand_start);
+    for (size_t i = 0; i < potential_cands.size(); ++i) {
+      if (!cand_start_close[i]) continue;
+      const contact::CubicBarrier barrier{settings.thickness, cand_stiffness[i]};
+      add_friction_row(constraint(cand_start[i]), -barrier.first(cand_start[i].distance));
+    }
+    for (int k : planes) {
+      const Obstacle& o = obstacles[static_cast<size_t>(k)];
+      Eigen::Vector3d q0, n0;
+      plane_at(o, t, q0, n0);
+      const RigidMap move = step_map(o, t);
+      for (Eigen::Index p = 0; p < p0.rows(); ++p) {
+        const Eigen::Vector3d a = p0.row(p).transpose();
+        const double dist = n0.dot(a - q0);
+        if (!(dist < settings.thickness)) continue;
+        Constraint c = point_constraint(static_cast<int>(p), n0);
+        c.mu = o.friction;
+        c.obstacle_velocity = -(move(a) - a) / h;
+        const contact::CubicBarrier barrier{settings.thickness, plane_stiffness[static_cast<size_t>(p)]};
+        add_friction_row(c, -barrier.first(dist));
+      }
+    }
+    potential_ms += ms_since(t0);
+  }
+
+  // A constraint on one surface point (a plane's pair) with normal n.
+  Constraint point_constraint(int p, const Eigen::Vector3d& normal) {
+    PairGeometry g;
+    g.num = 1;
+    g.point[0] = p;
+    g.coef[0] = 1.0;
+    g.normal = normal;
+    return constraint(g);
+  }
+
+  void add_friction_row(const Constraint& c, double lambda) {
+    if (!(c.mu > 0) || !(lambda > 0)) return;
+    FrictionRow f;
+    f.row = node_row(c);
+    f.constant = c.obstacle_velocity;
+    f.tangent -= c.normal * c.normal.transpose();
+    f.bound = c.mu * lambda;
+    friction_rows.push_back(std::move(f));
+  }
+
+  double friction_epsilon() const { return settings.tolerance * settings.thickness / h; }
+
+  void linearise_potential(const Eigen::VectorXd& v, double t, PotentialLinearisation& out) {
+    const auto t0 = Clock::now();
+    const Eigen::Index n3 = v.size();
+    out.blocks.clear();
+    out.energy = out.dissipation = 0.0;
+    out.active = 0;
+    out.energy_gradient.setZero(n3);
+    out.dissipation_gradient.setZero(n3);
+    end_points_current = false;
+    update_end_points(v);
+    // Candidates made for other end points serve while no point is more than half the
+    // thickness from where they were made for (their boxes are grown by twice the thickness).
+    double off = 0.0;
+    for (Eigen::Index i = 0; i < p1.rows(); ++i) off = std::max(off, (p1.row(i) - potential_guess.row(i)).norm());
+    if (off > 0.5 * settings.thickness || largest_move(p0, built_p0) > 0.5 * settings.thickness) {
+      ContactReport scratch;
+      make_potential_candidates(scratch);
+    }
+    const double dhat = settings.thickness;
+    std::vector<char> active(potential_cands.size(), 0);
+    std::vector<PairGeometry> end(potential_cands.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Candidate& c = potential_cands[i];
+        if (c.near) continue;
+        const std::array<Eigen::Vector3d, 4> corner = corners(c, true);
+        if (!within_boxes(corner, is_point_triangle(c.kind), dhat)) continue;  // (most candidates: no exact distance)
+        end[i] = geometry(c, corner);
+        if (redundant_on_flat_face(c, end[i], corner)) continue;
+        sign_by_start(c, cand_start[i], end[i], is_point_triangle(c.kind));
+        active[i] = end[i].distance < dhat;
+      }
+    });
+    auto add_pair = [&](const Constraint& c, double distance, double k) {
+      const contact::CubicBarrier barrier{dhat, k};
+      out.energy += barrier.value(distance);
+      PotentialLinearisation::Block block;
+      block.row = node_row(c);
+      block.row.scatter(barrier.first(distance) * c.normal, out.energy_gradient);
+      block.hessian = barrier.second(distance) * c.normal * c.normal.transpose();
+      out.blocks.push_back(std::move(block));
+      ++out.active;
+    };
+    // A cloth point against an obstacle keeps its closest triangle only: the barrier is of the
+    // point's distance to the obstacle, the smallest over its triangles (one pair where a point
+    // over a face has several triangles within the thickness, and none of them twice).
+    keep_closest(active, end);
+    for (size_t i = 0; i < potential_cands.size(); ++i)
+      if (active[i]) add_pair(constraint(end[i]), end[i].distance, cand_stiffness[i]);
+    for (int k : planes) {
+      Eigen::Vector3d q1, n1;
+      plane_at(obstacles[static_cast<size_t>(k)], t + h, q1, n1);
+      for (Eigen::Index p = 0; p < p1.rows(); ++p) {
+        const double dist = n1.dot(p1.row(p).transpose() - q1);
+        if (dist < dhat) add_pair(point_constraint(static_cast<int>(p), n1), dist, plane_stiffness[static_cast<size_t>(p)]);
+      }
+    }
+    const contact::SmoothedFriction friction{friction_epsilon()};
+    for (const FrictionRow& f : friction_rows) {
+      const Eigen::Vector3d w = f.tangent * (f.row.apply(v) + f.constant);
+      out.dissipation += f.bound * friction.f0(w.norm());
+      f.row.scatter(friction.gradient(w, f.bound), out.dissipation_gradient);
+      PotentialLinearisation::Block block;
+      block.row = f.row;
+      block.hessian = friction.hessian(w, f.tangent, f.bound);
+      block.dissipative = true;
+      out.blocks.push_back(std::move(block));
+    }
+    potential_ms += ms_since(t0);
+  }
+
   // --- The stage ---------------------------------------------------------------------------------
   const ResponseSystem* system = nullptr;
   std::unique_ptr<CholeskyPreconditioner> newton_factor;  // of the implicit response's Newton matrix
@@ -1514,6 +1807,26 @@ struct ContactStage::Impl {
 
   std::vector<Found> constraints;  // this step's, with their multipliers
 
+  // The surface points and obstacle vertices at the start of the step (and the obstacles' at its
+  // end); the end points are to be made from the velocities.
+  void start_positions(const Eigen::VectorXd& x, double t) {
+    const Eigen::MatrixX3d net = d.control_net(x);
+    p0.resize(surface.position.rows(), 3);
+    parallel_product(surface.position, net.data(), net.rows(), 3, p0.data());
+    end_points_current = false;
+    obstacle_boxes_current = false;
+    if (!obstacle_of_vertex.empty()) {
+      o0.resize(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
+      o1.resize(o0.rows(), 3);
+      for (size_t k = 0; k < obstacles.size(); ++k) {
+        const Obstacle& o = obstacles[k];
+        if (o.shape == Obstacle::Shape::plane) continue;
+        o0.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t);
+        o1.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t + h);
+      }
+    }
+  }
+
   ContactReport filter(const Eigen::VectorXd& x, double t, double step, Eigen::VectorXd& v, const ResponseSystem& sys) {
     constraints.clear();
     const ContactReport report = run(x, t, step, v, sys);
@@ -1528,23 +1841,8 @@ struct ContactStage::Impl {
     auto t0 = Clock::now();
     system_diagonal = sys.matrix.diagonal();
     const Eigen::VectorXd base = v;  // the solve's velocities, v*
-    {
-      const Eigen::MatrixX3d net = d.control_net(x);
-      p0.resize(surface.position.rows(), 3);
-      parallel_product(surface.position, net.data(), net.rows(), 3, p0.data());
-    }
-    end_points_current = false;
-    obstacle_boxes_current = false;
-    if (!obstacle_of_vertex.empty()) {
-      o0.resize(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
-      o1.resize(o0.rows(), 3);
-      for (size_t k = 0; k < obstacles.size(); ++k) {
-        const Obstacle& o = obstacles[k];
-        if (o.shape == Obstacle::Shape::plane) continue;
-        o0.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t);
-        o1.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t + h);
-      }
-    }
+    candidate_grow = 0.0;
+    start_positions(x, t);
     update_end_points(v);
     report.narrow_ms += ms_since(t0);
 
@@ -1552,14 +1850,27 @@ struct ContactStage::Impl {
     // pairs that start closer than the minimum separation are pushed apart by a fraction of the
     // shortfall per step.
     const double eta = params.min_separation_ratio * settings.thickness;
-    std::vector<Candidate> cands = candidates(report);
+    std::vector<Candidate> cands;
     bool cands_current = true;  // made for the current end points
-    constraints = proximity(cands, t, report);
-    warm_start(constraints);
-    report.proximity_pairs = static_cast<int>(constraints.size());
-    for (Found& f : constraints) f.constraint.target = params.repulsion_ratio * std::max(0.0, eta - f.distance) / h;
-    if (!constraints.empty()) {
-      implicit_response(constraints, base, v, report);
+    if (potential_on) {
+      // Proximity is the potential's, inside the step (begin_potential / linearise); here only the
+      // fail-safe, on the potential's candidates where they serve this step's motion
+      // (candidates_serve).
+      if (candidates_serve()) {
+        cands = potential_cands;
+      } else {
+        candidate_grow = 0.0;
+        cands = candidates(report);
+      }
+    } else {
+      cands = candidates(report);
+      constraints = proximity(cands, t, report);
+      warm_start(constraints);
+      report.proximity_pairs = static_cast<int>(constraints.size());
+      for (Found& f : constraints) f.constraint.target = params.repulsion_ratio * std::max(0.0, eta - f.distance) / h;
+      if (!constraints.empty()) {
+        implicit_response(constraints, base, v, report);
+      }
     }
 
     // Continuous collision detection: each pass adds the pairs that collide to the constraints
@@ -1640,6 +1951,32 @@ ContactStage::~ContactStage() = default;
 ContactReport ContactStage::filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v,
                                    const ResponseSystem& system) {
   return impl_->filter(x, t, h, v, system);
+}
+
+void ContactStage::enable_potential() { impl_->potential_on = true; }
+bool ContactStage::potential_enabled() const { return impl_->potential_on; }
+
+void ContactStage::begin_step(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double h,
+                              const Eigen::VectorXd& diagonal) {
+  impl_->begin_potential(x, v_guess, t, h, diagonal);
+  impl_->potential_t = t;
+}
+
+void ContactStage::linearise(const Eigen::VectorXd& v, PotentialLinearisation& out) {
+  impl_->linearise_potential(v, impl_->potential_t, out);
+}
+
+void ContactStage::end_step(const Eigen::VectorXd& v, PotentialReport& report) {
+  (void)v;
+  report.friction_pairs = static_cast<int>(impl_->friction_rows.size());
+  report.ms = 0.0;
+}
+
+double ContactStage::velocity_tolerance(double h) const {
+  // 1 % of collision.tolerance's velocity (a fraction of the thickness per step), as the
+  // constraints' response stops its Newton steps: the energy error of the step then stays far
+  // below the tolerance's own scale (docs/contact.md).
+  return 0.01 * impl_->settings.tolerance * impl_->settings.thickness / h;
 }
 
 const SurfaceOperator& ContactStage::surface() const { return impl_->surface; }

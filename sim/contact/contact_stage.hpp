@@ -32,6 +32,7 @@
 #include "sim/contact/broad_phase.hpp"
 #include "sim/contact/obstacle.hpp"
 #include "sim/discretization/discretization.hpp"
+#include "sim/integrator/step_potential.hpp"
 #include "sim/solver/pcg.hpp"
 
 #include <Eigen/Core>
@@ -73,6 +74,10 @@ struct ContactParameters {
   int friction_updates = 3;          // updates in which the friction bound follows the normal impulse
   double response_cg_tolerance = 1e-6;
   int refactor_iterations = 15;      // refactorise the Newton matrix after a solve that needed more
+  // The contact potential inside the step (docs/contact.md, "Contact inside the step"): the
+  // barrier's stiffness k per pair, as k h² = barrier_ratio × the effective mass of its lightest
+  // cloth point through the step's matrix.
+  double barrier_ratio = 4.0;
 };
 
 // The step's linear system for the implicit response: A = M + h D + h² K (only the rows and
@@ -94,6 +99,18 @@ class ContactStage {
   // Filters the step from time t to t + h: x the start positions (3·#nodes) [m], v the new
   // velocities [m/s] (the solution of `system`), changed in place on free components only.
   ContactReport filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, const ResponseSystem& system);
+
+  // Contact inside the implicit step (sim/integrator/step_potential.hpp): after
+  // enable_potential(), proximity is a barrier energy of the end positions with lagged friction,
+  // which the integrator minimises with the elastic model (begin_step / linearise / end_step), and
+  // filter() is the fail-safe only: continuous collision detection with the implicit response
+  // on colliding pairs, then impact zones.
+  void enable_potential();
+  bool potential_enabled() const;
+  void begin_step(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double h, const Eigen::VectorXd& diagonal);
+  void linearise(const Eigen::VectorXd& v, PotentialLinearisation& out);
+  void end_step(const Eigen::VectorXd& v, PotentialReport& report);
+  double velocity_tolerance(double h) const;
 
   // The collision surface (the display operator at surface_level) and its points at x.
   const SurfaceOperator& surface() const;

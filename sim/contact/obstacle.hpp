@@ -29,6 +29,12 @@ struct CollisionSettings {
   double friction = 0.3;      // [-] Coulomb coefficient cloth–cloth, and the obstacles' default
   double tolerance = 1e-3;    // [-] of the contact response, in velocity: this fraction of the
                               // thickness per step (docs/contact.md)
+  // How proximity is treated (scene key collision.method): "barrier", a barrier energy of the
+  // step's end positions with lagged friction, minimised inside the implicit step with the
+  // elastic model, the constraints of the velocity filter being the fail-safe only; or
+  // "constraints", every pair within the thickness a constraint of the velocity filter
+  // (the method before 2026-11-28; docs/contact.md).
+  bool barrier = true;
   // Not a scene key. Two patches of the collision surface in one star of a control vertex, or in
   // the two stars of a control edge, are not tested against each other while the normals of that
   // region stay within a cone of this half-angle [rad] over the whole step (docs/contact.md,

@@ -20,12 +20,23 @@ namespace clothsim {
 
 namespace {
 
-// The contact stage as the integrator's velocity filter.
-class ContactFilter final : public VelocityFilter {
+// The contact stage as the integrator's step potential (proximity inside the step) and velocity
+// filter (the fail-safe after it).
+class ContactFilter final : public VelocityFilter, public StepPotential {
  public:
   ContactFilter(const Discretization& d, const Eigen::VectorXd& mass, const std::vector<char>& free,
                 const CollisionSettings& settings, const std::vector<Obstacle>& obstacles, const ContactParameters& p)
-      : stage_(d, mass, free, settings, obstacles, p) {}
+      : stage_(d, mass, free, settings, obstacles, p) {
+    if (settings.barrier) stage_.enable_potential();
+  }
+  bool inside_step() const { return stage_.potential_enabled(); }
+  void begin_step(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double h,
+                  const Eigen::VectorXd& diagonal) override {
+    stage_.begin_step(x, v_guess, t, h, diagonal);
+  }
+  void linearise(const Eigen::VectorXd& v, PotentialLinearisation& out) override { stage_.linearise(v, out); }
+  void end_step(const Eigen::VectorXd& v, PotentialReport& report) override { stage_.end_step(v, report); }
+  double velocity_tolerance(double h) const override { return stage_.velocity_tolerance(h); }
   void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, const StepSystem& system,
               StepStats& stats) override {
     const ContactReport r = stage_.filter(x, t, h, v, ResponseSystem{system.matrix, system.inverse});
@@ -58,7 +69,7 @@ struct Simulator::Impl {
   LinearSolver solver;
   DynamicState state;
   std::unique_ptr<ImplicitEuler> integrator;
-  std::unique_ptr<VelocityFilter> contact;  // only when the problem has contact
+  std::unique_ptr<ContactFilter> contact;  // only when the problem has contact
   Eigen::MatrixX3d node_points_rest;
   double shell_rotate_ms = 0.0;  // rotation time of the shell's updates so far
 
@@ -85,6 +96,7 @@ struct Simulator::Impl {
                                                   problem.obstacles, parameters);
       }
       integrator->set_velocity_filter(contact.get());
+      if (contact->inside_step()) integrator->set_step_potential(contact.get());
     }
     skip_rotation_time();
   }
@@ -176,6 +188,7 @@ double Simulator::kinetic_energy() const { return impl_->integrator->kinetic_ene
 double Simulator::elastic_energy() const { return impl_->integrator->elastic_energy(); }
 double Simulator::external_work() const { return impl_->integrator->external_work(); }
 double Simulator::boundary_work() const { return impl_->integrator->boundary_work(); }
+double Simulator::contact_energy() const { return impl_->integrator->potential_energy(); }
 double Simulator::max_membrane_strain() const {
   return impl_->discretization->max_membrane_strain(impl_->integrator->displacement());
 }

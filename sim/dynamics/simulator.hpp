@@ -69,6 +69,10 @@ class Simulator {
   double elastic_energy() const;
   double external_work() const;
   double boundary_work() const;
+  // The contact barrier's energy at the current state [J] (0 without contact or with
+  // collision.method "constraints"): a potential energy of the positions, part of the mechanical
+  // energy with kinetic and elastic (docs/contact.md, "Contact inside the step").
+  double contact_energy() const;
   // Largest |principal Green–Lagrange membrane strain| of the surface in the current state [-]
   // (Discretization::max_membrane_strain: for loop_kl of the limit surface at the element
   // barycentres, for linear_fe and mass_spring of the flat triangles); computed on demand, a pass

@@ -1,6 +1,7 @@
 #include "sim/integrator/implicit_euler.hpp"
 
 #include "sim/core/sparse_pattern.hpp"
+#include "sim/solver/pcg.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -63,11 +64,130 @@ void ImplicitEuler::restore(const DynamicState& state, const IntegratorCheckpoin
       (c.v_previous.size() != 0 && c.v_previous.size() != n3))
     throw std::invalid_argument("ImplicitEuler::restore: the checkpoint's state does not fit the mesh (" +
                                 std::to_string(n3 / 3) + " nodes)");
+  if (c.coupled_pattern.empty()) {
+    coupled_in_use_ = false;
+  } else {
+    coupled_.restore(system_, c.coupled_pattern);
+    coupled_in_use_ = true;
+  }
   u_ = c.u;
   v_previous_ = c.v_previous;
   work_ = c.external_work;
   boundary_work_ = c.boundary_work;
   update_terms(state.x, u_, state.t);
+}
+
+IntegratorCheckpoint ImplicitEuler::checkpoint() const {
+  IntegratorCheckpoint c{u_, v_previous_, work_, boundary_work_, {}};
+  if (coupled_in_use_) c.coupled_pattern = coupled_.adjacency();
+  return c;
+}
+
+LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b,
+                                                      const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v,
+                                                      StepStats& stats) {
+  const Eigen::Index n3 = v.size();
+  auto clock = [] { return std::chrono::steady_clock::now(); };
+  auto t0 = clock();
+  potential_->begin_step(x, v, t, h, a.diagonal());
+  PotentialLinearisation lin;
+  potential_->linearise(v, lin);
+  double potential_ms = ms_since(t0);
+  // Φ(v) = ½ vᵀ A v − bᵀ v + E(x + h v) + h Ψ(v) (step_potential.hpp).
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n3);
+  Eigen::VectorXd product(n3);
+  auto merit = [&](const Eigen::VectorXd& w, const PotentialLinearisation& l) {
+    symmetric_product(a, w, ones, product);
+    return 0.5 * w.dot(product) - b.dot(w) + l.energy + h * l.dissipation;
+  };
+  double phi = merit(v, lin);
+  LinearSolveReport total;
+  total.converged = true;
+  Eigen::VectorXd rhs(n3), v_new(n3), trial(n3), gradient(n3), estimate(n3);
+  PotentialLinearisation next;
+  const double tolerance = potential_->velocity_tolerance(h);
+  constexpr int kMaxNewton = 12;
+  int iterations = 0;
+  for (;;) {
+    // The pattern: A's and the couplings of the blocks; rebuilt only when a block needs a
+    // coupling it lacks (then the solver analyses the new pattern).
+    std::vector<std::vector<int>> groups;
+    groups.reserve(lin.blocks.size());
+    for (const PotentialLinearisation::Block& block : lin.blocks) groups.push_back(block.row.node_list());
+    std::sort(groups.begin(), groups.end());  // (many rows share their nodes: each list is checked once)
+    groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
+    if (!coupled_.covers(a, groups)) coupled_.rebuild(a, groups, /*keep_previous=*/true);
+    coupled_.set_base(a);
+    rhs = b;
+    Eigen::VectorXd hv = Eigen::VectorXd::Zero(n3);  // (h² ∇²E + h ∇²Ψ) v
+    for (const PotentialLinearisation::Block& block : lin.blocks) {
+      const double weight = block.dissipative ? h : h * h;
+      const Eigen::Matrix3d hw = weight * block.hessian;
+      coupled_.add_block(block.row, hw);
+      block.row.scatter(hw * block.row.apply(v), hv);
+    }
+    if (lin.energy_gradient.size() == n3) rhs -= h * lin.energy_gradient;
+    if (lin.dissipation_gradient.size() == n3) rhs -= h * lin.dissipation_gradient;
+    rhs += hv;
+    v_new = v;
+    coupled_in_use_ = true;
+    const LinearSolveReport r = solver_.solve(coupled_.matrix(), rhs, free_, v_new);
+    total.iterations += r.iterations;
+    total.residual = r.residual;
+    total.factorizations += r.factorizations;
+    total.factor_ms += r.factor_ms;
+    ++iterations;
+    if (!r.converged) {
+      total.converged = false;
+      total.failure = r.failure;
+      break;
+    }
+    // A step that raises Φ is shortened (halved up to four times; the last one is taken).
+    t0 = clock();
+    potential_->linearise(v_new, next);
+    double phi_new = merit(v_new, next);
+    for (int halve = 0; halve < 4 && phi_new > phi + 1e-12 * std::abs(phi); ++halve) {
+      trial = 0.5 * (v + v_new);
+      v_new = trial;
+      potential_->linearise(v_new, next);
+      phi_new = merit(v_new, next);
+    }
+    potential_ms += ms_since(t0);
+    // Converged when the next Newton step, estimated with the solver's preconditioner (a factor
+    // of this or an earlier Newton matrix) from the gradient of Φ at v_new, is below the
+    // tolerance: the step just taken may be small only because the model was stiff. With no
+    // potential at either end the solve was exact.
+    double change = 0.0;
+    if (!(lin.empty() && next.empty())) {
+      gradient = product - b;  // (product = A v_new: merit() was last called at v_new)
+      if (next.energy_gradient.size() == n3) gradient += h * next.energy_gradient;
+      if (next.dissipation_gradient.size() == n3) gradient += h * next.dissipation_gradient;
+      for (Eigen::Index i = 0; i < n3; ++i)
+        if (!free_[static_cast<size_t>(i)]) gradient(i) = 0.0;
+      solver_.preconditioner(coupled_.matrix(), free_)(gradient, estimate);
+      for (Eigen::Index i = 0; i < n3; ++i)
+        if (free_[static_cast<size_t>(i)]) change = std::max(change, std::abs(estimate(i)));
+    }
+    v = v_new;
+    std::swap(lin, next);
+    phi = phi_new;
+    if (change <= tolerance || iterations >= kMaxNewton) break;
+  }
+  t0 = clock();
+  PotentialReport report;
+  report.newton_iterations = iterations;
+  report.active_pairs = lin.active;
+  report.energy = lin.energy;
+  potential_->end_step(v, report);
+  potential_ms += ms_since(t0) + report.ms;
+  stats.contact_newton_iterations += report.newton_iterations;
+  stats.contact_active_pairs = report.active_pairs;
+  stats.contact_friction_pairs = report.friction_pairs;
+  stats.contact_energy = report.energy;
+  stats.contact_potential_ms += potential_ms;
+  stats.contact_ms += potential_ms;
+  stats.solve_ms -= potential_ms;  // (the caller times the whole call as the solve)
+  return total;
 }
 
 void ImplicitEuler::update_terms(const Eigen::VectorXd& x, const Eigen::VectorXd& u, double t) {
@@ -177,7 +297,10 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     stats.assemble_ms += ms_since(t0);
 
     t0 = std::chrono::steady_clock::now();
-    const LinearSolveReport report = solver_.solve(a, b, free_, v_next);
+    const bool last = k + 1 == settings_.newton_iterations;
+    const LinearSolveReport report = potential_ && last ? solve_with_potential(a, b, x, state.t, h, v_next, stats)
+                                                        : solver_.solve(a, b, free_, v_next);
+    if (!(potential_ && last)) coupled_in_use_ = false;
     stats.solver_iterations += report.iterations;
     stats.residual = report.residual;
     stats.factorizations += report.factorizations;
@@ -236,6 +359,7 @@ StepStats ImplicitEuler::step(DynamicState& state) {
   stats.update_ms += ms_since(t0);
 
   v_previous_ = v;
+  potential_energy_ = stats.contact_energy;
   work_ += stats.external_work;
   boundary_work_ += stats.boundary_work;
   state.x = std::move(x_next);

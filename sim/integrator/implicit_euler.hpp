@@ -22,6 +22,7 @@
 #pragma once
 
 #include "sim/integrator/scripted_boundary.hpp"
+#include "sim/integrator/step_potential.hpp"
 #include "sim/discretization/discretization.hpp"
 #include "sim/forces/force_term.hpp"
 #include "sim/solver/linear_solver.hpp"
@@ -83,6 +84,12 @@ struct StepStats {
   int contact_response_iterations = 0;   // augmented-Lagrangian updates of the implicit response
   long long contact_cg_iterations = 0;   // conjugate-gradient iterations in them
   int contact_response_factorizations = 0;  // Cholesky factorisations of the response's Newton matrix
+  // The contact potential inside the step (StepPotential; zero without one).
+  int contact_newton_iterations = 0;  // linear solves of the step with the potential in them
+  int contact_active_pairs = 0;       // barrier pairs active at the end of the step
+  int contact_friction_pairs = 0;     // pairs with lagged friction in the step
+  double contact_energy = 0.0;        // the barrier's energy at the end of the step [J]
+  double contact_potential_ms = 0.0;  // evaluating the potential (part of contact_ms) [ms]
 };
 
 // The step's linear system as the solve left it, for a velocity filter that responds implicitly:
@@ -138,6 +145,9 @@ class SimulationError : public std::runtime_error {
 struct IntegratorCheckpoint {
   Eigen::VectorXd u, v_previous;
   double external_work = 0.0, boundary_work = 0.0;
+  // The coupled pattern of the last solve with a step potential (per node, the coupled nodes;
+  // empty without one): the solver's factor is of a matrix with this pattern.
+  std::vector<std::vector<int>> coupled_pattern;
 };
 
 class ImplicitEuler {
@@ -180,14 +190,21 @@ class ImplicitEuler {
   // A filter of the new velocities after each solve (contact); null for none. Must outlive the
   // integrator.
   void set_velocity_filter(VelocityFilter* filter) { filter_ = filter; }
+  // A potential of the end positions minimised inside the step (contact, step_potential.hpp);
+  // null for none. Must outlive the integrator.
+  void set_step_potential(StepPotential* potential) { potential_ = potential; }
+  // The step potential's energy at the current state [J] (0 without one).
+  double potential_energy() const { return potential_energy_; }
   // Which DOFs are unknowns of the linear solve (3·#nodes): the ones a velocity filter may change.
   const std::vector<char>& free_dofs() const { return free_; }
-  IntegratorCheckpoint checkpoint() const { return {u_, v_previous_, work_, boundary_work_}; }
+  IntegratorCheckpoint checkpoint() const;
   // Continues from `c`, taken at `state`: sets the integrator's state and evaluates the terms at
   // it, as the step that reached it did. Throws std::invalid_argument on a size mismatch.
   void restore(const DynamicState& state, const IntegratorCheckpoint& c);
-  // The step's system matrix (its pattern is fixed for the run; the solver's checkpoint refers to it).
-  const Eigen::SparseMatrix<double>& system_matrix() const { return system_; }
+  // The matrix of the last linear solve: the step's system matrix (its pattern fixed for the run),
+  // or, with a step potential, that matrix with the potential's couplings (the solver's
+  // checkpoint refers to it).
+  const Eigen::SparseMatrix<double>& system_matrix() const { return coupled_in_use_ ? coupled_.matrix() : system_; }
   // Displacement from the rest state (3·#nodes) [m] of the last state reached, consistent.
   const Eigen::VectorXd& displacement() const { return u_; }
 
@@ -214,6 +231,14 @@ class ImplicitEuler {
   double size_ = 1.0;                     // bounding-box diagonal of the rest state [m]
   double work_ = 0.0, boundary_work_ = 0.0;
   VelocityFilter* filter_ = nullptr;
+  StepPotential* potential_ = nullptr;
+  CoupledMatrix coupled_;          // the step's matrix with the potential's blocks
+  bool coupled_in_use_ = false;    // the last solve was on coupled_
+  double potential_energy_ = 0.0;
+  // Newton on the incremental potential with the step potential in it (step_potential.hpp):
+  // v holds the start and receives the result; a and b are the elastic system.
+  LinearSolveReport solve_with_potential(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
+                                         double t, double h, Eigen::VectorXd& v, StepStats& stats);
 };
 
 }  // namespace clothsim

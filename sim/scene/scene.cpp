@@ -948,11 +948,12 @@ Imperfection read_imperfection(const Reader& r, const Json* j) {
   return imp;
 }
 
-// "collision": {"self": bool, "thickness": m, "friction": -, "tolerance": -, "surface_level": int}.
+// "collision": {"self": bool, "thickness": m, "friction": -, "tolerance": -, "surface_level": int,
+//               "method": "barrier" | "constraints"}.
 void read_collision(const Reader& r, const Json* j, Problem& problem, bool& level_given) {
   level_given = false;
   if (j == nullptr) return;
-  r.check_object(*j, "collision", {"self", "thickness", "friction", "tolerance", "surface_level"});
+  r.check_object(*j, "collision", {"self", "thickness", "friction", "tolerance", "surface_level", "method"});
   CollisionSettings& c = problem.collision;
   if (const Json* v = r.find(*j, "self")) c.self = r.boolean(*v, "collision.self");
   if (const Json* v = r.find(*j, "thickness")) c.thickness = r.positive(*v, "collision.thickness", "[m]");
@@ -960,6 +961,11 @@ void read_collision(const Reader& r, const Json* j, Problem& problem, bool& leve
   if (const Json* v = r.find(*j, "tolerance")) {
     c.tolerance = r.positive(*v, "collision.tolerance", "[-]");
     if (c.tolerance > 0.1) r.fail("collision.tolerance", "must be > 0 and at most 0.1 (got " + v->dump() + ")");
+  }
+  if (const Json* v = r.find(*j, "method")) {
+    if (!v->is_string() || (*v != "barrier" && *v != "constraints"))
+      r.fail("collision.method", "must be \"barrier\" or \"constraints\" (got " + v->dump() + ")");
+    c.barrier = *v == "barrier";
   }
   if (const Json* v = r.find(*j, "surface_level")) {
     problem.collision_level = r.integer_at_least(*v, "collision.surface_level", 0);

@@ -42,6 +42,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kG = 9.81;  // [m/s²]
 
+// Whether contact acted in a step: the barrier inside the step held pairs, or the fail-safe after
+// it gave impulses (with collision.method "constraints", every pair within the thickness).
+int contact_acted(const StepStats& s) { return s.contact_active_pairs + s.contact_impulses; }
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -391,11 +395,11 @@ DropRun drop_on_ground(double friction, double tolerance = CollisionSettings{}.t
   run.mass = sim.vertex_mass().sum();
   run.dt = p.time.dt;
   // Mechanical energy: kinetic + elastic + gravity's potential (minus the work gravity did).
-  auto energy = [&] { return sim.kinetic_energy() + sim.elastic_energy() - sim.external_work(); };
+  auto energy = [&] { return sim.kinetic_energy() + sim.elastic_energy() + sim.contact_energy() - sim.external_work(); };
   double previous = energy();
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
-    run.impulses += s.contact_impulses;
+    run.impulses += contact_acted(s);
     run.unresolved += s.contact_unresolved;
     const Eigen::VectorXd z = drawn_points(sim, op).col(2);
     if (z.minCoeff() < run.lowest) {
@@ -490,13 +494,14 @@ struct SlopeRun {
 };
 
 // A 0.1 m square patch of 6 × 6 cells resting on a plane through the origin tilted by θ about
-// the y axis (its normal R e_z, downhill R e_x, gravity −z), starting at 0.9 × thickness above
-// it, at rest; friction μ on the plane and between cloth parts.
+// the y axis (its normal R e_z, downhill R e_x, gravity −z), starting at the thickness above it
+// (at the edge of the contact layer, where the barrier starts), at rest; friction μ on the plane
+// and between cloth parts.
 SlopeRun slide(double theta_deg, double mu, double duration) {
   const double thickness = 1e-3;
   const Eigen::Matrix3d r = Eigen::AngleAxisd(theta_deg * kPi / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
   const Eigen::Vector3d normal = r * Eigen::Vector3d::UnitZ(), downhill = r * Eigen::Vector3d::UnitX();
-  Problem p = cloth_problem(transformed(make_grid(0.1, 0.1, 6, 6), r, 0.9 * thickness * normal), 1e-3, duration);
+  Problem p = cloth_problem(transformed(make_grid(0.1, 0.1, 6, 6), r, thickness * normal), 1e-3, duration);
   p.gravity = Eigen::Vector3d(0, 0, -kG);
   p.collision.thickness = thickness;
   p.collision.friction = mu;
@@ -638,10 +643,11 @@ CollisionRun collide_patches() {
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
     run.unresolved += s.contact_unresolved;
-    run.impulses += s.contact_impulses;
+    run.impulses += contact_acted(s);
     run.zones += s.impact_zones;
-    if (s.contact_impulses > 0 && run.first_contact == 0) run.first_contact = i + 1;
-    const double kinetic = sim.kinetic_energy(), elastic = sim.elastic_energy();
+    if (contact_acted(s) > 0 && run.first_contact == 0) run.first_contact = i + 1;
+    // (the barrier's energy with the elastic: both are potential energies of the positions)
+    const double kinetic = sim.kinetic_energy(), elastic = sim.elastic_energy() + sim.contact_energy();
     if (run.scale == 0.0 && sim.state().t > run.push_until + 1e-9) {
       run.scale = (sim.state().velocities().rowwise().norm().transpose() * sim.vertex_mass())(0);
       run.before_contact = kinetic + elastic;
@@ -663,7 +669,7 @@ CollisionRun collide_patches() {
     previous_elastic = elastic;
     run.self_pairs += check::self_intersections(to_surface(drawn_points(sim, op), op.triangles)).intersecting_pairs;
   }
-  run.end_energy = sim.kinetic_energy() + sim.elastic_energy();
+  run.end_energy = sim.kinetic_energy() + sim.elastic_energy() + sim.contact_energy();
   run.seconds = seconds_since(t0);
   return run;
 }
@@ -722,7 +728,7 @@ IntersectionTally run_and_check(Simulator& sim, const Problem& p, int level) {
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
     tally.unresolved += s.contact_unresolved;
-    tally.impulses += s.contact_impulses;
+    tally.impulses += contact_acted(s);
     tally.zones += s.impact_zones;
     tally.contact_ms += s.contact_ms;
     const auto t0 = std::chrono::steady_clock::now();
@@ -849,7 +855,7 @@ TEST(ContactCulling, FlatRegionsDropPairsButChangeNothing) {
     for (int i = 0; i < sim.num_steps(); ++i) {
       const StepStats s = sim.step();
       r.pairs += s.contact_pairs;
-      r.impulses += s.contact_impulses;
+      r.impulses += contact_acted(s);
     }
     r.x = sim.state().x;
     return r;

@@ -255,7 +255,7 @@ TEST_F(ContactKeys, CollisionErrors) {
   EXPECT_EQ(collision(R"({"self": "yes"})"), expected("collision.self: expected true or false (got \"yes\")"));
   EXPECT_TRUE(contains(collision(R"({"thickness": "1mm"})"), expected("collision.thickness: expected a number")));
   EXPECT_EQ(collision(R"({"margin": 0.01})"),
-            expected("collision.margin: unknown key (allowed: self, thickness, friction, tolerance, surface_level)"));
+            expected("collision.margin: unknown key (allowed: self, thickness, friction, tolerance, surface_level, method)"));
   EXPECT_TRUE(contains(collision("true"), expected("collision: expected an object")));
 }
 
@@ -514,38 +514,50 @@ TEST_F(ContactKeysCli, BadContactKeysWriteNothing) {
 
 // The implicit response's figures in summary.json are the sums of their stats.csv columns, on a
 // run whose response refactorises its Newton matrix (a sheet pressed onto the ground with
-// friction and self-collision on).
+// friction and self-collision on, proximity as constraints of the response); and the barrier's
+// Newton iterations likewise, on the same run with the default method.
 TEST_F(ContactKeysCli, ResponseFiguresSumTheirColumns) {
-  const fs::path scene = write("press.json", R"({"name": "press", "analysis": "dynamic",
+  auto press = [&](const std::string& name, const std::string& method) {
+    return write(name + ".json", R"({"name": ")" + name + R"(", "analysis": "dynamic",
       "mesh": {"primitive": "grid", "size": [0.2, 0.2], "divisions": [8, 8],
                "rotate": {"axis": [1, 0, 0], "angle_deg": -90}, "translate": [0, 0.0015, 0]},
       "material": {"preset": "cotton"},
       "loads": {"gravity": [0, -9.81, 0]},
       "time": {"dt": 0.001, "end": 0.004, "output_fps": 500},
-      "collision": {"thickness": 0.002, "friction": 0.5, "self": true},
+      "collision": {"thickness": 0.002, "friction": 0.5, "self": true, "method": ")" + method + R"("},
       "obstacles": [{"name": "ground", "primitive": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}]})");
-  const RunResult r = run_scene(scene, "--no-render");
+  };
+  // (stats.csv column, summary.json "contact" key)
+  auto expect_sums = [&](const std::string& name, const std::vector<std::pair<std::string, std::string>>& columns) {
+    std::istringstream in(clothsim::testing::read_file_bytes(out() / name / "stats.csv"));
+    std::string field;
+    std::getline(in, field);
+    std::vector<std::string> names;
+    for (std::istringstream header(field); std::getline(header, field, ',');) names.push_back(field);
+    std::map<std::string, long long> sums;
+    int rows = 0;
+    for (std::string row; std::getline(in, row); ++rows) {
+      std::istringstream fields(row);
+      for (std::size_t k = 0; k < names.size() && std::getline(fields, field, ','); ++k)
+        for (const auto& entry : columns)
+          if (entry.first == names[k]) sums[names[k]] += std::stoll(field);
+    }
+    EXPECT_EQ(rows, 4);
+    const nlohmann::json summary = nlohmann::json::parse(clothsim::testing::read_file_bytes(out() / name / "summary.json"));
+    for (const auto& [column, key] : columns) {
+      EXPECT_EQ(sums.count(column), 1u) << column << " is not a column of stats.csv";
+      EXPECT_EQ(sums[column], summary["contact"][key].get<long long>()) << column;
+      EXPECT_GT(sums[column], 0) << column;  // the cloth is pressed onto the ground: the method works
+    }
+  };
+  const RunResult r = run_scene(press("press", "constraints"), "--no-render");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  const std::vector<std::string> keys = {"response_iterations", "response_cg_iterations", "response_factorizations"};
-  std::istringstream in(clothsim::testing::read_file_bytes(out() / "press" / "stats.csv"));
-  std::string field;
-  std::getline(in, field);
-  std::vector<std::string> names;
-  for (std::istringstream header(field); std::getline(header, field, ',');) names.push_back(field);
-  std::map<std::string, long long> sums;
-  int rows = 0;
-  for (std::string row; std::getline(in, row); ++rows) {
-    std::istringstream fields(row);
-    for (std::size_t k = 0; k < names.size() && std::getline(fields, field, ','); ++k)
-      if (std::find(keys.begin(), keys.end(), names[k]) != keys.end()) sums[names[k]] += std::stoll(field);
-  }
-  EXPECT_EQ(rows, 4);
-  const nlohmann::json summary = nlohmann::json::parse(clothsim::testing::read_file_bytes(out() / "press" / "summary.json"));
-  for (const std::string& key : keys) {
-    EXPECT_EQ(sums.count(key), 1u) << key << " is not a column of stats.csv";
-    EXPECT_EQ(sums[key], summary["contact"][key].get<long long>()) << key;
-    EXPECT_GT(sums[key], 0) << key;  // the cloth is pressed onto the ground: the response works
-  }
+  expect_sums("press", {{"response_iterations", "response_iterations"},
+                        {"response_cg_iterations", "response_cg_iterations"},
+                        {"response_factorizations", "response_factorizations"}});
+  const RunResult b = run_scene(press("press_barrier", "barrier"), "--no-render");
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  expect_sums("press_barrier", {{"contact_newton_iterations", "newton_iterations"}});
 }
 
 // A short run: the contact figures appear in stats.csv and summary.json only with contact, and
@@ -576,7 +588,8 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
     return line;
   };
   const std::string contact_columns =
-      ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations";
+      ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,"
+      "response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy";
   const std::string header_with = first_line(out() / "touch" / "stats.csv");
   const std::string header_without = first_line(out() / "free" / "stats.csv");
   EXPECT_EQ(header_with.size() >= contact_columns.size() &&

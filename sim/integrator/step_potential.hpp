@@ -1,0 +1,65 @@
+// A potential of the step's end positions that the implicit step minimises together with the
+// elastic model (contact inside the step: sim/contact/contact_potential.hpp, docs/contact.md).
+//
+// Implicit Euler with the velocities v as unknowns is the minimisation of the incremental
+// potential
+//     Φ(v) = ½ vᵀ A v − bᵀ v + E(x + h v) + h Ψ(v),
+// A = M + h D + h² K and b = M v₀ + h f₀ the step's linearised elastic system
+// (sim/integrator/implicit_euler.hpp), E a potential energy of the end positions [J] (a contact
+// barrier) and Ψ a convex dissipation potential of the velocities [W] (lagged friction). The
+// integrator takes Newton steps on Φ: at v_k it asks the potential for E, Ψ, their gradients and
+// their Hessians as blocks Bᵀ H B on rows B (sim/solver/coupled_matrix.hpp), and solves
+//     (A + h² ∇²E + h ∇²Ψ) v = b − h ∇E − h ∇Ψ + (h² ∇²E + h ∇²Ψ) v_k.
+// The weights h² and h are the integrator's; the potential reports ∇ₓE and ∇ᵥΨ per node DOF.
+#pragma once
+
+#include "sim/solver/coupled_matrix.hpp"
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace clothsim {
+
+// A potential's value, gradients and Hessian blocks at one velocity v_k.
+struct PotentialLinearisation {
+  double energy = 0.0;       // E(x + h v_k) [J]
+  double dissipation = 0.0;  // Ψ(v_k) [W]
+  Eigen::VectorXd energy_gradient;       // ∇ₓE at x + h v_k, 3·#nodes [N] (zero-sized: none)
+  Eigen::VectorXd dissipation_gradient;  // ∇ᵥΨ at v_k, 3·#nodes [N] (zero-sized: none)
+  struct Block {
+    NodeRow row;
+    Eigen::Matrix3d hessian;  // H of Bᵀ H B: [N/m] for E, [N·s/m] for Ψ
+    bool dissipative = false; // a block of ∇²Ψ (weight h) rather than ∇²E (weight h²)
+  };
+  std::vector<Block> blocks;
+  int active = 0;  // active pairs (barrier) this linearisation holds
+  bool empty() const { return blocks.empty() && energy == 0.0 && dissipation == 0.0; }
+};
+
+// What one step's potential did (summed into StepStats by the integrator's owner).
+struct PotentialReport {
+  int newton_iterations = 0;  // linearisations solved
+  int active_pairs = 0;       // barrier pairs active at the end of the step
+  int friction_pairs = 0;     // pairs with lagged friction in the step
+  double energy = 0.0;        // E at the end of the step [J]
+  double ms = 0.0;            // time spent evaluating the potential (candidates, pairs) [ms]
+};
+
+class StepPotential {
+ public:
+  virtual ~StepPotential() = default;
+  // Starts the step from x (3·#nodes) [m] at time t [s] with length h [s]; v_guess [m/s] is the
+  // integrator's start for the new velocities (the potential may prepare for end positions near
+  // x + h v_guess). `diagonal`: the diagonal of the step's elastic matrix A per DOF (scales).
+  virtual void begin_step(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double h,
+                          const Eigen::VectorXd& diagonal) = 0;
+  // Linearises at the velocities v (end positions x + h v).
+  virtual void linearise(const Eigen::VectorXd& v, PotentialLinearisation& out) = 0;
+  // Called once per step with the accepted velocities and the report so far (to fill in).
+  virtual void end_step(const Eigen::VectorXd& v, PotentialReport& report) = 0;
+  // Whether the velocity change from v_k to v_{k+1} is small enough to stop Newton [m/s].
+  virtual double velocity_tolerance(double h) const = 0;
+};
+
+}  // namespace clothsim
