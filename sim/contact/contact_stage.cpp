@@ -1102,8 +1102,7 @@ struct ContactStage::Impl {
       // forms: `nodes`, when every node's three DOFs are free and b(3k + c) = w_k e_c (the collision
       // surface's Jacobian is S ⊗ I₃, the usual case), so u = Σ w_k v_k; else `b`, per DOF.
       // The node form is a third of the entries and of the arithmetic, with the same sums.
-      std::vector<std::pair<int, Eigen::Vector3d>> b;  // free DOFs (empty in the node form)
-      std::vector<std::pair<int, double>> nodes;       // (node k, w_k) in the node form
+      NodeRow row;  // free DOFs (dofs empty in the node form; nodes: (node k, w_k))
       Eigen::Vector3d constant = Eigen::Vector3d::Zero();  // eᵢ
       Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
       Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity();  // I − n nᵀ
@@ -1124,7 +1123,7 @@ struct ContactStage::Impl {
       double w = 0.0;
       for (const auto& [dof, b] : con.b) {
         if (free[static_cast<size_t>(dof)]) {
-          r.b.emplace_back(dof, b);
+          r.row.dofs.emplace_back(dof, b);
           w += std::pow(b.dot(con.normal), 2) / diagonal(dof);
         } else {
           r.constant += b * v(dof);
@@ -1135,7 +1134,7 @@ struct ContactStage::Impl {
         con.friction.setZero();
         continue;
       }
-      to_node_form(r.b, r.nodes);
+      to_node_form(r.row.dofs, r.row.nodes);
       r.normal = con.normal;
       r.tangent -= con.normal * con.normal.transpose();
       r.kappa = params.penalty_ratio / w;
@@ -1150,16 +1149,8 @@ struct ContactStage::Impl {
       report.response_ms += ms_since(t0);
       return;
     }
-    auto relative = [&](const Row& r, const Eigen::VectorXd& x) {  // uᵢ(x) without eᵢ
-      Eigen::Vector3d u = Eigen::Vector3d::Zero();
-      for (const auto& [node, w] : r.nodes) u += w * x.segment<3>(3 * node);
-      for (const auto& [dof, b] : r.b) u += b * x(dof);
-      return u;
-    };
-    auto scatter = [&](const Row& r, const Eigen::Vector3d& force, Eigen::VectorXd& y) {  // y += Bᵢᵀ force
-      for (const auto& [node, w] : r.nodes) y.segment<3>(3 * node) += w * force;
-      for (const auto& [dof, b] : r.b) y(dof) += b.dot(force);
-    };
+    auto relative = [&](const Row& r, const Eigen::VectorXd& x) { return r.row.apply(x); };  // uᵢ(x) without eᵢ
+    auto scatter = [&](const Row& r, const Eigen::Vector3d& force, Eigen::VectorXd& y) { r.row.scatter(force, y); };  // y += Bᵢᵀ force
     auto disc = [](const Eigen::Vector3d& y, double radius) -> Eigen::Vector3d {
       const double norm = y.norm();
       if (norm <= radius) return y;
@@ -1227,78 +1218,19 @@ struct ContactStage::Impl {
       // couple nodes far apart in the mesh). It is rebuilt, with a new symbolic analysis, only when
       // a constraint needs a coupling it lacks.
       std::vector<std::vector<int>> row_nodes(rows.size());
-      bool covered = newton_pattern.matrix.rows() == n3 && newton_pattern.a_entries == a.nonZeros();
-      for (size_t k = 0; k < rows.size(); ++k) {
-        std::vector<int>& nodes = row_nodes[k];
-        for (const auto& entry : rows[k].nodes) nodes.push_back(entry.first);
-        for (const auto& entry : rows[k].b) nodes.push_back(entry.first / 3);
-        std::sort(nodes.begin(), nodes.end());
-        nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
-        for (size_t x = 0; covered && x < nodes.size(); ++x)
-          for (size_t y = 0; covered && y < nodes.size(); ++y)
-            covered = newton_pattern.has(nodes[x], nodes[y]);
-      }
-      if (!covered) {
-        newton_pattern.rebuild(a, row_nodes, d.num_nodes());
+      for (size_t k = 0; k < rows.size(); ++k) row_nodes[k] = rows[k].row.node_list();
+      if (!newton_pattern.covers(a, row_nodes)) {
+        newton_pattern.rebuild(a, row_nodes);
         newton_factor = std::make_unique<CholeskyPreconditioner>();
       }
-      Eigen::SparseMatrix<double>& m = newton_pattern.matrix;
-      double* values = m.valuePtr();
-      std::fill(values, values + m.nonZeros(), 0.0);
-      for (Eigen::Index k = 0; k < a.nonZeros(); ++k) values[newton_pattern.from_a[static_cast<size_t>(k)]] += a.valuePtr()[k];
-      // Each constraint adds Bₚᵀ H B_q for every pair of its nodes (B_k: the 3 × 3 block of node k):
-      // the pattern holds full node blocks, so node p's rows in column 3q + c start at
-      // outer[3q + c] + 3 · (p's rank among q's coupled nodes).
-      const int* outer_index = m.outerIndexPtr();
-      std::vector<std::pair<int, Eigen::Matrix3d>> blocks;  // (node, B_k)
-      std::vector<std::pair<int, double>> weights;          // (node, w_k), node form
+      newton_pattern.set_base(a);
       for (const Row& r : rows) {
         if (r.passive()) continue;
         Eigen::Matrix3d hessian = r.friction_hessian;
         if (r.normal_active) hessian += r.kappa * r.normal * r.normal.transpose();
-        if (r.b.empty()) {
-          // The node form: Bₚᵀ H B_q = w_p w_q H. The nodes sorted, each node's ranks among the
-          // others' couplings are found by one merge instead of a search per pair.
-          weights.assign(r.nodes.begin(), r.nodes.end());
-          std::sort(weights.begin(), weights.end());
-          for (const auto& [q, wq] : weights) {
-            const Eigen::Matrix3d hq = hessian * wq;
-            const std::vector<int>& coupled = newton_pattern.adjacency[static_cast<size_t>(q)];
-            auto at = coupled.begin();
-            for (const auto& [p, wp] : weights) {
-              at = std::lower_bound(at, coupled.end(), p);
-              const int rank = static_cast<int>(at - coupled.begin());
-              for (int c = 0; c < 3; ++c) {
-                double* column = values + outer_index[3 * q + c] + 3 * rank;
-                for (int k = 0; k < 3; ++k) column[k] += wp * hq(k, c);
-              }
-            }
-          }
-          continue;
-        }
-        blocks.clear();
-        for (const auto& [dof, b] : r.b) {
-          const int node = dof / 3;
-          auto it = std::find_if(blocks.begin(), blocks.end(), [node](const auto& e) { return e.first == node; });
-          if (it == blocks.end()) {
-            blocks.emplace_back(node, Eigen::Matrix3d::Zero());
-            it = blocks.end() - 1;
-          }
-          it->second.col(dof % 3) = b;
-        }
-        for (const auto& [q, bq] : blocks) {
-          const Eigen::Matrix3d hbq = hessian * bq;
-          const std::vector<int>& coupled = newton_pattern.adjacency[static_cast<size_t>(q)];
-          for (const auto& [p, bp] : blocks) {
-            const int rank = static_cast<int>(std::lower_bound(coupled.begin(), coupled.end(), p) - coupled.begin());
-            const Eigen::Matrix3d block = bp.transpose() * hbq;
-            for (int c = 0; c < 3; ++c) {
-              double* column = values + outer_index[3 * q + c] + 3 * rank;
-              for (int k = 0; k < 3; ++k) column[k] += block(k, c);
-            }
-          }
-        }
+        newton_pattern.add_block(r.row, hessian);
       }
+      const Eigen::SparseMatrix<double>& m = newton_pattern.matrix();
       ++report.response_factorizations;
       if (!newton_factor) newton_factor = std::make_unique<CholeskyPreconditioner>();
       if (!newton_factor->factorize(m, &free)) newton_factor.reset();  // then the step's own preconditioner
@@ -1760,49 +1692,8 @@ struct ContactStage::Impl {
   // --- The stage ---------------------------------------------------------------------------------
   const ResponseSystem* system = nullptr;
   std::unique_ptr<CholeskyPreconditioner> newton_factor;  // of the implicit response's Newton matrix
-  // The pattern of that matrix: A's and the node couplings of the constraints it was made for.
-  struct NewtonPattern {
-    Eigen::SparseMatrix<double> matrix;                // the pattern, with the last values
-    Eigen::Index a_entries = -1;                       // A's entries when it was built
-    std::vector<int> from_a;                           // A's k-th stored entry is matrix's from_a[k]-th
-    std::vector<std::vector<int>> adjacency;           // per node, the coupled nodes (sorted)
-    bool has(int p, int q) const {
-      const std::vector<int>& row = adjacency[static_cast<size_t>(p)];
-      return std::binary_search(row.begin(), row.end(), q);
-    }
-    void rebuild(const Eigen::SparseMatrix<double>& a, const std::vector<std::vector<int>>& row_nodes, int num_nodes) {
-      adjacency.assign(static_cast<size_t>(num_nodes), {});
-      for (Eigen::Index col = 0; col < a.outerSize(); ++col)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it)
-          adjacency[static_cast<size_t>(col / 3)].push_back(static_cast<int>(it.row() / 3));
-      for (const std::vector<int>& nodes : row_nodes)
-        for (int p : nodes) adjacency[static_cast<size_t>(p)].insert(adjacency[static_cast<size_t>(p)].end(), nodes.begin(), nodes.end());
-      std::vector<Eigen::Triplet<double>> entries;
-      for (size_t p = 0; p < adjacency.size(); ++p) {
-        std::vector<int>& row = adjacency[p];
-        std::sort(row.begin(), row.end());
-        row.erase(std::unique(row.begin(), row.end()), row.end());
-        for (int q : row)
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j) entries.emplace_back(3 * q + i, 3 * static_cast<int>(p) + j, 0.0);
-      }
-      matrix.resize(a.rows(), a.cols());
-      matrix.setFromTriplets(entries.begin(), entries.end());
-      matrix.makeCompressed();
-      a_entries = a.nonZeros();
-      from_a.assign(static_cast<size_t>(a.nonZeros()), 0);
-      const int* outer_index = matrix.outerIndexPtr();
-      const int* inner_index = matrix.innerIndexPtr();
-      for (Eigen::Index col = 0; col < a.outerSize(); ++col)
-        for (Eigen::SparseMatrix<double>::InnerIterator it(a, col); it; ++it) {
-          const int* first = inner_index + outer_index[col];
-          const int* last = inner_index + outer_index[col + 1];
-          from_a[static_cast<size_t>(&it.valueRef() - a.valuePtr())] =
-              static_cast<int>(std::lower_bound(first, last, static_cast<int>(it.row())) - inner_index);
-        }
-    }
-  };
-  NewtonPattern newton_pattern;
+  // That matrix: A's pattern and the node couplings of the constraints it was made for.
+  CoupledMatrix newton_pattern;
   Eigen::VectorXd system_diagonal;  // of A, per DOF
 
   std::vector<Found> constraints;  // this step's, with their multipliers
