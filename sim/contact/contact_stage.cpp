@@ -1415,6 +1415,11 @@ struct ContactStage::Impl {
   std::vector<FrictionRow> friction_rows;
   double potential_ms = 0.0;
   std::map<std::pair<int, int>, size_t> closest;  // scratch: (cloth point, obstacle) -> candidate
+  Eigen::VectorXd point_motion;                   // scratch of linearise_potential
+  Eigen::VectorXd potential_x;                    // the step's start positions (begin_potential)
+  std::pair<double, double> potential_step_start{-1.0, 0.0};  // its t and h
+  Eigen::VectorXd p1_velocity;                    // the velocities p1 was made from
+  std::vector<PairGeometry> end;                  // scratch of linearise_potential
 
   double barrier_ratio() const { return params.barrier_ratio; }
 
@@ -1470,17 +1475,34 @@ struct ContactStage::Impl {
     for (size_t i = 0; i < potential_cands.size(); ++i) cand_stiffness[i] = pair_stiffness(potential_cands[i]);
     // Each pair's geometry at the start of the step: its side (the barrier's distance is signed
     // by it, see linearise_potential) and, for pairs pressed at the start, lagged friction.
+    // (Computed here for the pairs whose boxes are within the thickness at the start, the others
+    // when a linearisation finds them within it at the end: start_geometry.)
     cand_start.resize(potential_cands.size());
+    cand_start_known.assign(potential_cands.size(), 0);
     cand_start_close.assign(potential_cands.size(), 0);
+    cand_start_lower.assign(potential_cands.size(), 0.0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const Candidate& c = potential_cands[i];
         if (c.near) continue;
         const std::array<Eigen::Vector3d, 4> corner = corners(c, false);
-        cand_start[i] = geometry(c, corner);
+        const double gap = box_gap(corner, is_point_triangle(c.kind));
+        cand_start_lower[i] = gap;
+        if (!(gap < settings.thickness)) continue;
+        cand_start_lower[i] = start_geometry(i).distance;
         cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face(c, cand_start[i], corner);
       }
     });
+  }
+  std::vector<char> cand_start_known;
+  std::vector<double> cand_start_lower;  // a lower bound of each pair's distance at the start [m]
+  // Candidate i's geometry at the start of the step (computed once per step; each i by one thread).
+  const PairGeometry& start_geometry(size_t i) {
+    if (!cand_start_known[i]) {
+      cand_start[i] = geometry(potential_cands[i], corners(potential_cands[i], false));
+      cand_start_known[i] = 1;
+    }
+    return cand_start[i];
   }
   // Of the flagged cloth-point–obstacle-triangle candidates, keeps (flagged) the closest triangle
   // per point and obstacle.
@@ -1505,6 +1527,21 @@ struct ContactStage::Impl {
   std::vector<PairGeometry> cand_start;  // per candidate, at the start of the step
   std::vector<char> cand_start_close;    // ... within the thickness there
 
+  // The largest gap along an axis between the boxes of a pair's two primitives (0 when they
+  // overlap): a lower bound of their distance [m].
+  static double box_gap(const std::array<Eigen::Vector3d, 4>& x, bool point_triangle) {
+    Eigen::Vector3d lo_a = x[0], hi_a = x[0], lo_b, hi_b;
+    if (point_triangle) {
+      lo_b = x[1].cwiseMin(x[2]).cwiseMin(x[3]);
+      hi_b = x[1].cwiseMax(x[2]).cwiseMax(x[3]);
+    } else {
+      lo_a = x[0].cwiseMin(x[1]);
+      hi_a = x[0].cwiseMax(x[1]);
+      lo_b = x[2].cwiseMin(x[3]);
+      hi_b = x[2].cwiseMax(x[3]);
+    }
+    return std::max(0.0, std::max((lo_b - hi_a).maxCoeff(), (lo_a - hi_b).maxCoeff()));
+  }
   // Whether the two primitives of a pair (a point and a triangle's corners, or two edges' end
   // points) have boxes closer than `reach` in every axis: otherwise their distance is at least that.
   static bool within_boxes(const std::array<Eigen::Vector3d, 4>& x, bool point_triangle, double reach) {
@@ -1547,8 +1584,11 @@ struct ContactStage::Impl {
     potential_ms = 0.0;
     h = step;
     start_positions(x, t);
+    potential_x = x;
+    potential_step_start = {t, step};
     end_points_current = false;
     update_end_points(v_guess);
+    p1_velocity = v_guess;
     // Effective masses of the surface points through J, with each node's scale s_k the mean of
     // its three diagonal entries of A (a rotation leaves the trace of a node's block unchanged).
     Eigen::VectorXd scale(d.num_nodes());
@@ -1626,8 +1666,11 @@ struct ContactStage::Impl {
     out.active = 0;
     out.energy_gradient.setZero(n3);
     out.dissipation_gradient.setZero(n3);
-    end_points_current = false;
-    update_end_points(v);
+    if (!(v.size() == p1_velocity.size() && v == p1_velocity)) {
+      end_points_current = false;
+      update_end_points(v);
+      p1_velocity = v;
+    }
     // Candidates made for other end points serve while no point is more than half the
     // thickness from where they were made for (their boxes are grown by twice the thickness).
     double off = 0.0;
@@ -1637,17 +1680,29 @@ struct ContactStage::Impl {
       make_potential_candidates(scratch);
     }
     const double dhat = settings.thickness;
+    // How far each surface point (and, at most, any obstacle vertex) moves over the step: a pair
+    // whose distance at the start exceeds the thickness by more than its points' motion cannot be
+    // within it at the end (most candidates of a slow or resting cloth).
+    point_motion.resize(p1.rows());
+    for (Eigen::Index i = 0; i < p1.rows(); ++i) point_motion(i) = (p1.row(i) - p0.row(i)).norm();
+    const double obstacle_motion = o0.rows() > 0 ? (o1 - o0).rowwise().norm().maxCoeff() : 0.0;
     std::vector<char> active(potential_cands.size(), 0);
-    std::vector<PairGeometry> end(potential_cands.size());
+    end.resize(potential_cands.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const Candidate& c = potential_cands[i];
         if (c.near) continue;
+        double largest = 0.0;  // of the pair's cloth points
+        for (int q : cloth_points_of(c))
+          if (q >= 0) largest = std::max(largest, point_motion(q));
+        const bool cloth_cloth = c.kind == Kind::cloth_point_cloth_triangle || c.kind == Kind::cloth_edge_cloth_edge;
+        const double relative = cloth_cloth ? 2.0 * largest : largest + obstacle_motion;  // bounds the pair's relative motion
+        if (cand_start_lower[i] - relative >= dhat) continue;
         const std::array<Eigen::Vector3d, 4> corner = corners(c, true);
         if (!within_boxes(corner, is_point_triangle(c.kind), dhat)) continue;  // (most candidates: no exact distance)
         end[i] = geometry(c, corner);
         if (redundant_on_flat_face(c, end[i], corner)) continue;
-        sign_by_start(c, cand_start[i], end[i], is_point_triangle(c.kind));
+        if (end[i].distance < dhat) sign_by_start(c, start_geometry(i), end[i], is_point_triangle(c.kind));
         active[i] = end[i].distance < dhat;
       }
     });
@@ -1733,7 +1788,12 @@ struct ContactStage::Impl {
     system_diagonal = sys.matrix.diagonal();
     const Eigen::VectorXd base = v;  // the solve's velocities, v*
     candidate_grow = 0.0;
-    start_positions(x, t);
+    if (potential_on && potential_step_start == std::pair{t, step} && x.size() == potential_x.size() && x == potential_x) {
+      // The potential's start positions of this step; its last end points when they are of v.
+      end_points_current = v.size() == p1_velocity.size() && v == p1_velocity;
+    } else {
+      start_positions(x, t);
+    }
     update_end_points(v);
     report.narrow_ms += ms_since(t0);
 
