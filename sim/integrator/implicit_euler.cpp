@@ -171,7 +171,9 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
     v = v_new;
     std::swap(lin, next);
     phi = phi_new;
-    if (change <= tolerance || iterations >= kMaxNewton) break;
+    // (A solve that took no iteration changed nothing at the linear solver's tolerance: Newton
+    // cannot get closer than that.)
+    if (change <= tolerance || r.iterations == 0 || iterations >= kMaxNewton) break;
   }
   t0 = clock();
   PotentialReport report;
@@ -235,7 +237,10 @@ StepStats ImplicitEuler::step(DynamicState& state) {
   // starting from v, on sleeve_twist 15 % fewer), v in the first step or with
   // extrapolated_start off. The solution does not depend on it beyond the tolerance.
   Eigen::VectorXd v_next = v;
-  if (settings_.extrapolated_start && v_previous_.size() == v.size())
+  // With a step potential (contact) Newton starts from v itself: extrapolating a contact's motion
+  // linearises the barrier where the cloth is not going (sheet_on_sphere, 0.5 s: 3.52 against 4.20
+  // Newton iterations per step; sleeve_on_arm, 0.2 s: 2.79 against 3.03).
+  if (settings_.extrapolated_start && v_previous_.size() == v.size() && potential_ == nullptr)
     for (Eigen::Index i = 0; i < v.size(); ++i)
       if (free_[i]) v_next(i) = v(i) + (v(i) - v_previous_(i));
   for (size_t i = 0; i < prescribed.size(); ++i)
