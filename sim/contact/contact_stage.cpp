@@ -1419,7 +1419,7 @@ struct ContactStage::Impl {
   Eigen::VectorXd potential_x;                    // the step's start positions (begin_potential)
   std::pair<double, double> potential_step_start{-1.0, 0.0};  // its t and h
   Eigen::VectorXd p1_velocity;                    // the velocities p1 was made from
-  std::vector<PairGeometry> end;                  // scratch of linearise_potential
+  std::vector<PairGeometry> end_geometry;         // scratch of linearise_potential
 
   double barrier_ratio() const { return params.barrier_ratio; }
 
@@ -1559,21 +1559,18 @@ struct ContactStage::Impl {
   }
 
   // The pair's distance signed by the side it started on: a pair whose closest points are inside
-  // both primitives (a point over a triangle's interior, two edges at interior points) and whose
-  // normal turned against its normal at the start of the step has passed through: its distance is
-  // negative and its normal the start side's, so the barrier pushes it back rather than through.
-  // (Where a closest point is on a primitive's boundary the normal can turn round an edge without
-  // a crossing; there the distance stays unsigned.)
-  static void sign_by_start(const Candidate& c, const PairGeometry& start, PairGeometry& end, bool point_triangle) {
+  // both primitives (a point over a triangle's interior, two edges at interior points) at the
+  // start and at the end of the step and whose normal turned against its start normal has passed
+  // through: its distance is negative and its normal the start side's, so the barrier pushes it
+  // back rather than through. (Where a closest point is on a primitive's boundary the normal can
+  // turn round an edge without a crossing; there the distance stays unsigned.)
+  static void sign_by_start(const PairGeometry& start, PairGeometry& end, bool point_triangle) {
     if (!(end.normal.dot(start.normal) < 0)) return;
-    bool interior;
-    if (point_triangle) {
-      interior = -end.coef[1] > 0 && -end.coef[2] > 0 && -end.coef[3] > 0;
-    } else {
-      interior = end.coef[1] > 0 && end.coef[0] > 0 && end.coef[3] < 0 && end.coef[2] < 0;
-    }
-    (void)c;
-    if (!interior) return;
+    auto interior = [point_triangle](const PairGeometry& g) {
+      if (point_triangle) return -g.coef[1] > 0 && -g.coef[2] > 0 && -g.coef[3] > 0;
+      return g.coef[0] > 0 && g.coef[1] > 0 && g.coef[2] < 0 && g.coef[3] < 0;
+    };
+    if (!interior(start) || !interior(end)) return;
     end.distance = -end.distance;
     end.normal = -end.normal;
   }
@@ -1687,7 +1684,8 @@ struct ContactStage::Impl {
     for (Eigen::Index i = 0; i < p1.rows(); ++i) point_motion(i) = (p1.row(i) - p0.row(i)).norm();
     const double obstacle_motion = o0.rows() > 0 ? (o1 - o0).rowwise().norm().maxCoeff() : 0.0;
     std::vector<char> active(potential_cands.size(), 0);
-    end.resize(potential_cands.size());
+    end_geometry.resize(potential_cands.size());
+    std::vector<PairGeometry>& end = end_geometry;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const Candidate& c = potential_cands[i];
@@ -1702,7 +1700,7 @@ struct ContactStage::Impl {
         if (!within_boxes(corner, is_point_triangle(c.kind), dhat)) continue;  // (most candidates: no exact distance)
         end[i] = geometry(c, corner);
         if (redundant_on_flat_face(c, end[i], corner)) continue;
-        if (end[i].distance < dhat) sign_by_start(c, start_geometry(i), end[i], is_point_triangle(c.kind));
+        if (end[i].distance < dhat) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
         active[i] = end[i].distance < dhat;
       }
     });
@@ -1742,6 +1740,99 @@ struct ContactStage::Impl {
       out.blocks.push_back(std::move(block));
     }
     potential_ms += ms_since(t0);
+  }
+
+  // The end points p0 + h J v (#P × 3) for velocities v.
+  Eigen::MatrixX3d end_points_of(const Eigen::VectorXd& v) const {
+    Eigen::VectorXd pv(jacobian.rows());
+    parallel_product(jacobian, v.data(), v.size(), 1, pv.data());
+    return p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
+  }
+
+  double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
+    const auto t0 = Clock::now();
+    const Eigen::MatrixX3d pa = end_points_of(from), pb = end_points_of(to);
+    const double half = 0.5 * settings.thickness;
+    // Candidates for the move pa → pb: the potential's where both ends stay within half the
+    // thickness of the end they were made for (the move in between does too), else a broad phase
+    // over this move.
+    const std::vector<Candidate>* cands = &potential_cands;
+    std::vector<Candidate> own;
+    if (!(largest_move(pa, potential_guess) <= half && largest_move(pb, potential_guess) <= half &&
+          largest_move(p0, built_p0) <= half)) {
+      const Eigen::MatrixX3d start_points = p0, end_points = p1;
+      const bool boxes = obstacle_boxes_current;
+      p0 = pa;
+      p1 = pb;
+      candidate_grow = settings.thickness;
+      ContactReport scratch;
+      own = candidates(scratch);
+      candidate_grow = 0.0;
+      p0 = start_points;
+      p1 = end_points;
+      obstacle_boxes_current = boxes;
+      cands = &own;
+    }
+    // The obstacles stand where they are at the end of the step at both ends of the move.
+    auto corner = [&](const Candidate& c, const Eigen::MatrixX3d& p) {
+      const std::array<int, 4> cloth = cloth_points_of(c);
+      std::array<Eigen::Vector3d, 4> x = corners(c, true);  // (obstacle points at t + h)
+      // corners() puts the cloth points first for every kind but obstacle point–cloth triangle.
+      if (c.kind == Kind::obstacle_point_cloth_triangle) {
+        for (int k = 0; k < 3; ++k) x[static_cast<size_t>(k + 1)] = p.row(cloth[static_cast<size_t>(k)]).transpose();
+      } else {
+        for (size_t k = 0; k < 4; ++k)
+          if (cloth[k] >= 0) x[k] = p.row(cloth[k]).transpose();
+      }
+      return x;
+    };
+    const double eta = params.min_separation_ratio * settings.thickness;
+    const double near_eta = params.near_separation_ratio * settings.thickness;
+    std::vector<double> bound(cands->size(), 1.0);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cands->size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Candidate& c = (*cands)[i];
+        const std::array<Eigen::Vector3d, 4> a = corner(c, pa), b = corner(c, pb);
+        const bool pt = is_point_triangle(c.kind);
+        double separation = c.near ? near_eta : eta;
+        // A quick reject: the boxes of the swept primitives farther apart than the separation.
+        std::array<Eigen::Vector3d, 4> lo, hi;
+        for (size_t k = 0; k < 4; ++k) {
+          lo[k] = a[k].cwiseMin(b[k]);
+          hi[k] = a[k].cwiseMax(b[k]);
+        }
+        const size_t split = pt ? 1 : 2;  // the first primitive's corners, then the second's
+        Eigen::Vector3d la = lo[0], ha = hi[0], lb = lo[split], hb = hi[split];
+        for (size_t k = 1; k < split; ++k) {
+          la = la.cwiseMin(lo[k]);
+          ha = ha.cwiseMax(hi[k]);
+        }
+        for (size_t k = split + 1; k < 4; ++k) {
+          lb = lb.cwiseMin(lo[k]);
+          hb = hb.cwiseMax(hi[k]);
+        }
+        if (!(((la.array() - separation) <= hb.array()).all() && ((lb.array() - separation) <= ha.array()).all())) continue;
+        const double start_distance = geometry(c, a).distance;
+        if (!(start_distance > 0)) continue;  // (touching already: nothing to bound)
+        separation = std::min(separation, 0.5 * start_distance);
+        const contact::CcdResult r = pt ? contact::point_triangle_ccd(a, b, separation) : contact::edge_edge_ccd(a, b, separation);
+        if (r.hit) bound[i] = r.toi;
+      }
+    });
+    double alpha = 1.0;
+    for (double b : bound) alpha = std::min(alpha, b);
+    for (int k : planes) {
+      Eigen::Vector3d q1, n1;
+      plane_at(obstacles[static_cast<size_t>(k)], potential_t + h, q1, n1);
+      for (Eigen::Index p = 0; p < pa.rows(); ++p) {
+        const double da = n1.dot(pa.row(p).transpose() - q1), db = n1.dot(pb.row(p).transpose() - q1);
+        if (!(da > 0) || db >= std::min(eta, 0.5 * da)) continue;
+        const double separation = std::min(eta, 0.5 * da);
+        alpha = std::min(alpha, (da - separation) / (da - db));
+      }
+    }
+    potential_ms += ms_since(t0);
+    return std::max(0.0, alpha);
   }
 
   // --- The stage ---------------------------------------------------------------------------------
@@ -1921,6 +2012,10 @@ void ContactStage::end_step(const Eigen::VectorXd& v, PotentialReport& report) {
   (void)v;
   report.friction_pairs = static_cast<int>(impl_->friction_rows.size());
   report.ms = 0.0;
+}
+
+double ContactStage::step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
+  return impl_->step_bound(from, to);
 }
 
 double ContactStage::velocity_tolerance(double h) const {

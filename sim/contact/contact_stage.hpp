@@ -111,6 +111,10 @@ class ContactStage {
   void linearise(const Eigen::VectorXd& v, PotentialLinearisation& out);
   void end_step(const Eigen::VectorXd& v, PotentialReport& report);
   double velocity_tolerance(double h) const;
+  // StepPotential::step_bound: the fraction of the move from end positions x + h from to
+  // x + h to free of crossings (pairs kept a tenth of the thickness apart, a hundredth between
+  // parts near each other at rest; a pair already closer keeps half its distance).
+  double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to);
 
   // The collision surface (the display operator at surface_level) and its points at x.
   const SurfaceOperator& surface() const;

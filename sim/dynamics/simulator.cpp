@@ -37,6 +37,7 @@ class ContactFilter final : public VelocityFilter, public StepPotential {
   void linearise(const Eigen::VectorXd& v, PotentialLinearisation& out) override { stage_.linearise(v, out); }
   void end_step(const Eigen::VectorXd& v, PotentialReport& report) override { stage_.end_step(v, report); }
   double velocity_tolerance(double h) const override { return stage_.velocity_tolerance(h); }
+  double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) override { return stage_.step_bound(from, to); }
   void filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, const StepSystem& system,
               StepStats& stats) override {
     const ContactReport r = stage_.filter(x, t, h, v, ResponseSystem{system.matrix, system.inverse});

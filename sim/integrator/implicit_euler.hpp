@@ -236,9 +236,10 @@ class ImplicitEuler {
   bool coupled_in_use_ = false;    // the last solve was on coupled_
   double potential_energy_ = 0.0;
   // Newton on the incremental potential with the step potential in it (step_potential.hpp):
-  // v holds the start and receives the result; a and b are the elastic system.
+  // v holds the caller's start (and the fixed components) and receives the result, v_now is the
+  // velocity at the start of the step; a and b are the elastic system.
   LinearSolveReport solve_with_potential(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
-                                         double t, double h, Eigen::VectorXd& v, StepStats& stats);
+                                         const Eigen::VectorXd& v_now, double t, double h, Eigen::VectorXd& v, StepStats& stats);
 };
 
 }  // namespace clothsim

@@ -60,6 +60,12 @@ class StepPotential {
   virtual void end_step(const Eigen::VectorXd& v, PotentialReport& report) = 0;
   // Whether the velocity change from v_k to v_{k+1} is small enough to stop Newton [m/s].
   virtual double velocity_tolerance(double h) const = 0;
+  // The largest fraction α ∈ [0, 1] of the move of the end positions from velocities `from` to
+  // `to` (x + h from → x + h to, linearly) over which the potential stays defined: for contact,
+  // no pair of surfaces passes through another (continuous collision detection). The Newton
+  // iterates stay free of crossings, as the barrier needs (it pushes a pair apart along the side
+  // it is on).
+  virtual double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) = 0;
 };
 
 }  // namespace clothsim

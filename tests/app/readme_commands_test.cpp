@@ -110,6 +110,8 @@ const std::map<std::string, Form>& forms() {
       {"build/release/bench/render_bench", {{"{build}/bench/render_bench --benchmark_list_tests"}, "", "{build}/bench/render_bench"}},
       {"build/release/bench/dynamics_bench",
        {{"{build}/bench/dynamics_bench --benchmark_list_tests"}, "", "{build}/bench/dynamics_bench"}},
+      {"build/release/bench/contact_bench",
+       {{"{build}/bench/contact_bench --benchmark_list_tests"}, "", "{build}/bench/contact_bench"}},
       {"build/release/bench/plate_convergence",
        {{"{build}/bench/plate_convergence --max 8 --csv {tmp}/plate_convergence.csv",
          "test -s {tmp}/plate_convergence.csv"},
