@@ -1545,17 +1545,7 @@ struct ContactStage::Impl {
   // Whether the two primitives of a pair (a point and a triangle's corners, or two edges' end
   // points) have boxes closer than `reach` in every axis: otherwise their distance is at least that.
   static bool within_boxes(const std::array<Eigen::Vector3d, 4>& x, bool point_triangle, double reach) {
-    Eigen::Vector3d lo_a = x[0], hi_a = x[0], lo_b, hi_b;
-    if (point_triangle) {
-      lo_b = x[1].cwiseMin(x[2]).cwiseMin(x[3]);
-      hi_b = x[1].cwiseMax(x[2]).cwiseMax(x[3]);
-    } else {
-      lo_a = x[0].cwiseMin(x[1]);
-      hi_a = x[0].cwiseMax(x[1]);
-      lo_b = x[2].cwiseMin(x[3]);
-      hi_b = x[2].cwiseMax(x[3]);
-    }
-    return ((lo_a.array() - reach) <= hi_b.array()).all() && ((lo_b.array() - reach) <= hi_a.array()).all();
+    return box_gap(x, point_triangle) <= reach;
   }
 
   // The pair's distance signed by the side it started on: a pair whose closest points are inside
