@@ -518,8 +518,9 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
   if (first_step > steps)
     throw std::runtime_error("--resume " + run_dir.string() + ": the checkpoint is at step " +
                              std::to_string(first_step) + ", beyond the run's " + std::to_string(steps) + " steps");
-  const std::vector<std::string> warnings = settings_warnings(scene, steps);
+  std::vector<std::string> warnings = settings_warnings(scene, steps);
   for (const std::string& w : warnings) log_line("warning: " + w);
+  std::vector<int> unresolved_steps;  // steps that ended with contact pairs still colliding
   if (resume)
     log_line("resuming " + run_dir.string() + " at step " + std::to_string(first_step) + " (t = " +
              format_short(resume->sim.state.t) + " s) of " + std::to_string(steps));
@@ -631,6 +632,14 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
           totals.contact_impulses += s.contact_impulses;
           totals.impact_zones += s.impact_zones;
           totals.contact_unresolved += s.contact_unresolved;
+          if (s.contact_unresolved > 0) {
+            // The fail-safe gave up on these pairs: the surfaces may cross from this step on.
+            unresolved_steps.push_back(s.step);
+            log_line("warning: step " + std::to_string(s.step) + " (t = " + format_short(s.t) + " s): " +
+                     std::to_string(s.contact_unresolved) +
+                     " contact pair(s) still colliding at the end of the step; frames from this time on may show "
+                     "crossing surfaces (stats.csv: contact_unresolved)");
+          }
           totals.contact_ms += s.contact_ms;
           totals.contact_broad_ms += s.contact_broad_ms;
           totals.contact_narrow_ms += s.contact_narrow_ms;
@@ -687,6 +696,14 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
     }
   }
   const std::string status = !failure.empty() ? "failed" : interrupted != 0 ? "interrupted" : "completed";
+  if (!unresolved_steps.empty()) {
+    std::string list;
+    for (size_t i = 0; i < unresolved_steps.size() && i < 20; ++i) list += (i ? ", " : "") + std::to_string(unresolved_steps[i]);
+    if (unresolved_steps.size() > 20) list += ", ...";
+    warnings.push_back("contact: " + std::to_string(unresolved_steps.size()) +
+                       " step(s) ended with contact pairs still colliding (steps " + list +
+                       "); frames from those times on may show crossing surfaces");
+  }
   const std::string summary = summary_json(scene, totals, wall(), warnings, status, failure);
   try {
     write_atomically(dir / "summary.json", summary);
