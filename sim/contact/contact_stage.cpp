@@ -1413,7 +1413,6 @@ struct ContactStage::Impl {
     double bound = 0.0;  // μ λ [N]
   };
   std::vector<FrictionRow> friction_rows;
-  double potential_ms = 0.0;
   std::map<std::pair<int, int>, size_t> closest;  // scratch: (cloth point, obstacle) -> candidate
   Eigen::VectorXd point_motion;                   // scratch of linearise_potential
   Eigen::VectorXd potential_x;                    // the step's start positions (begin_potential)
@@ -1567,8 +1566,6 @@ struct ContactStage::Impl {
 
   void begin_potential(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double step,
                        const Eigen::VectorXd& diagonal) {
-    const auto t0 = Clock::now();
-    potential_ms = 0.0;
     h = step;
     start_positions(x, t);
     potential_x = x;
@@ -1620,7 +1617,6 @@ struct ContactStage::Impl {
         add_friction_row(c, -barrier.first(dist));
       }
     }
-    potential_ms += ms_since(t0);
   }
 
   // A constraint on one surface point (a plane's pair) with normal n.
@@ -1646,7 +1642,6 @@ struct ContactStage::Impl {
   double friction_epsilon() const { return settings.tolerance * settings.thickness / h; }
 
   void linearise_potential(const Eigen::VectorXd& v, double t, PotentialLinearisation& out) {
-    const auto t0 = Clock::now();
     const Eigen::Index n3 = v.size();
     out.blocks.clear();
     out.energy = out.dissipation = 0.0;
@@ -1729,7 +1724,6 @@ struct ContactStage::Impl {
       block.dissipative = true;
       out.blocks.push_back(std::move(block));
     }
-    potential_ms += ms_since(t0);
   }
 
   // The end points p0 + h J v (#P × 3) for velocities v.
@@ -1740,7 +1734,6 @@ struct ContactStage::Impl {
   }
 
   double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
-    const auto t0 = Clock::now();
     const Eigen::MatrixX3d pa = end_points_of(from), pb = end_points_of(to);
     const double half = 0.5 * settings.thickness;
     // Candidates for the move pa → pb: the potential's where both ends stay within half the
@@ -1821,7 +1814,6 @@ struct ContactStage::Impl {
         alpha = std::min(alpha, (da - separation) / (da - db));
       }
     }
-    potential_ms += ms_since(t0);
     return std::max(0.0, alpha);
   }
 
@@ -2001,7 +1993,6 @@ void ContactStage::linearise(const Eigen::VectorXd& v, PotentialLinearisation& o
 void ContactStage::end_step(const Eigen::VectorXd& v, PotentialReport& report) {
   (void)v;
   report.friction_pairs = static_cast<int>(impl_->friction_rows.size());
-  report.ms = 0.0;
 }
 
 double ContactStage::step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {

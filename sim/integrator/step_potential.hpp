@@ -43,7 +43,6 @@ struct PotentialReport {
   int active_pairs = 0;       // barrier pairs active at the end of the step
   int friction_pairs = 0;     // pairs with lagged friction in the step
   double energy = 0.0;        // E at the end of the step [J]
-  double ms = 0.0;            // time spent evaluating the potential (candidates, pairs) [ms]
 };
 
 class StepPotential {
