@@ -1021,10 +1021,13 @@ struct ContactStage::Impl {
   // Pairs whose distance may fall below the minimum separation during the step. With `moved`
   // (per surface point: its end position changed since the last test) and `last` (the pairs
   // that collided then, sorted), only pairs with a moved point or a previous collision are
-  // tested again: the others have the same positions, so the same (negative) answer.
+  // tested again: the others have the same positions, so the same (negative) answer. With
+  // `lower` (per candidate, a bound of its distance at a reference, see reference_bounds, which
+  // fills point_move), pairs that cannot come within the separation are not tested.
   std::vector<Found> collisions(const std::vector<Candidate>& cands, double t, ContactReport& report,
                                 const std::vector<char>* moved = nullptr, const std::vector<Candidate>* last = nullptr,
-                                std::vector<Candidate>* hit_pairs = nullptr) {
+                                std::vector<Candidate>* hit_pairs = nullptr, const std::vector<double>* lower = nullptr,
+                                double obstacle_motion = 0.0) {
     const auto t0 = Clock::now();
     const double eta = params.min_separation_ratio * settings.thickness;
     std::vector<Found> out;
@@ -1036,6 +1039,8 @@ struct ContactStage::Impl {
       long long count = 0;
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const Candidate& c = cands[i];
+        const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
+        if (lower != nullptr && (*lower)[i] - pair_motion(c, point_move, obstacle_motion) > separation) continue;
         if (moved != nullptr) {
           bool any = false;
           for (int p : cloth_points_of(c)) any = any || (p >= 0 && (*moved)[static_cast<size_t>(p)]);
@@ -1043,7 +1048,6 @@ struct ContactStage::Impl {
         }
         ++count;
         const std::array<Eigen::Vector3d, 4> a = corners(c, false), b = corners(c, true);
-        const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
         const contact::CcdResult r = is_point_triangle(c.kind) ? contact::point_triangle_ccd(a, b, separation)
                                                                : contact::edge_edge_ccd(a, b, separation);
         if (r.hit) toi[i] = r.toi;
@@ -1414,7 +1418,6 @@ struct ContactStage::Impl {
   };
   std::vector<FrictionRow> friction_rows;
   std::map<std::pair<int, int>, size_t> closest;  // scratch: (cloth point, obstacle) -> candidate
-  Eigen::VectorXd point_motion;                   // scratch of linearise_potential
   Eigen::VectorXd potential_x;                    // the step's start positions (begin_potential)
   std::pair<double, double> potential_step_start{-1.0, 0.0};  // its t and h
   Eigen::VectorXd p1_velocity;                    // the velocities p1 was made from
@@ -1448,17 +1451,21 @@ struct ContactStage::Impl {
   // CCD) is among them. So they are kept from step to step while the cloth moves little (a
   // resting drape), and made again when it moves on.
   Eigen::MatrixX3d built_p0, built_o0, built_o1;  // the motion they were made for (and potential_guess)
+  // (Half the thickness. A radius of 1 or 2.5 thicknesses took 2.2 or 9.6 times the contact time
+  // on sleeve_on_arm's first 0.6 s: the candidates grow faster than their rebuilds get rarer.)
+  double serve_radius() const { return 0.5 * settings.thickness; }
   static double largest_move(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
     if (a.rows() != b.rows()) return std::numeric_limits<double>::infinity();
     return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
   }
   bool candidates_serve() const {
-    const double half = 0.5 * settings.thickness;
+    const double half = serve_radius();
     return largest_move(p0, built_p0) <= half && largest_move(p1, potential_guess) <= half &&
            largest_move(o0, built_o0) <= half && largest_move(o1, built_o1) <= half;
   }
   void make_potential_candidates(ContactReport& report) {
-    candidate_grow = 2.0 * settings.thickness;
+    lin_bounds_valid = false;
+    candidate_grow = settings.thickness + 2.0 * serve_radius();
     potential_cands = candidates(report);
     candidate_grow = 0.0;
     potential_guess = p1;
@@ -1470,6 +1477,12 @@ struct ContactStage::Impl {
   // Per step (and after a new broad phase): each candidate's barrier stiffness and geometry at
   // the start of the step.
   void prepare_candidates() {
+    // The last step's final linearisation holds bounds at its end points, the obstacles at its
+    // end: this step's start (the same surface up to the fail-safe's changes and round-off, which
+    // the points' moves from it account for).
+    const bool carried = lin_bounds_valid && lin_lower.size() == potential_cands.size() && lin_time == potential_t;
+    if (carried) point_move = (p0 - lin_points).rowwise().norm();
+    lin_bounds_valid = false;
     cand_stiffness.resize(potential_cands.size());
     for (size_t i = 0; i < potential_cands.size(); ++i) cand_stiffness[i] = pair_stiffness(potential_cands[i]);
     // Each pair's geometry at the start of the step: its side (the barrier's distance is signed
@@ -1483,11 +1496,15 @@ struct ContactStage::Impl {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const Candidate& c = potential_cands[i];
-        if (c.near) continue;
+        if (carried) {
+          const double bound = lin_lower[i] - pair_motion(c, point_move, 0.0);
+          cand_start_lower[i] = std::max(0.0, bound);
+          if (bound >= settings.thickness) continue;
+        }
         const std::array<Eigen::Vector3d, 4> corner = corners(c, false);
         const double gap = box_gap(corner, is_point_triangle(c.kind));
-        cand_start_lower[i] = gap;
-        if (!(gap < settings.thickness)) continue;
+        cand_start_lower[i] = std::max(cand_start_lower[i], gap);
+        if (c.near || !(gap < settings.thickness)) continue;
         cand_start_lower[i] = start_geometry(i).distance;
         cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face(c, cand_start[i], corner);
       }
@@ -1562,6 +1579,49 @@ struct ContactStage::Impl {
     if (!interior(start) || !interior(end)) return;
     end.distance = -end.distance;
     end.normal = -end.normal;
+  }
+
+  // Lower bounds of the candidates' distances at a reference configuration, so that a pair whose
+  // points have moved less than its bound allows is known to be apart without looking at it: the
+  // step's start (p0 and the obstacles at t: cand_start_lower), or the end points of the last
+  // linearisation (obstacles at t + h: lin_lower). Most candidates of a resting or slowly moving
+  // cloth are decided this way in each linearisation and each step bound.
+  std::vector<double> lin_lower;    // per candidate, at lin_points [m]
+  Eigen::MatrixX3d lin_points;      // the end points of the last linearisation
+  Eigen::VectorXd lin_velocity;     // ... and the velocities they were made from
+  bool lin_bounds_valid = false;    // lin_lower holds for this step's candidates
+  double lin_time = -1.0;           // the time of lin_points (the end of its step) [s]
+  Eigen::VectorXd point_move;       // scratch: per surface point, its move from the reference [m]
+
+  // How much a pair's distance can change when each of its cloth points p moves by at most
+  // move(p) and each obstacle vertex by at most `obstacle` [m] (the distance between two
+  // primitives changes by at most the largest move of a point of each).
+  double pair_motion(const Candidate& c, const Eigen::VectorXd& move, double obstacle) const {
+    const std::array<int, 4> q = cloth_points_of(c);
+    if (c.kind == Kind::cloth_point_cloth_triangle || c.kind == Kind::cloth_edge_cloth_edge) {
+      const size_t split = c.kind == Kind::cloth_point_cloth_triangle ? 1 : 2;
+      double a = 0.0, b = 0.0;
+      for (size_t k = 0; k < split; ++k) a = std::max(a, move(q[k]));
+      for (size_t k = split; k < 4; ++k) b = std::max(b, move(q[k]));
+      return a + b;
+    }
+    double largest = 0.0;
+    for (int p : q)
+      if (p >= 0) largest = std::max(largest, move(p));
+    return largest + obstacle;
+  }
+  // The reference for surface points `points` (and `other`, when not null: any move between the
+  // two), with the obstacles where they are at the end of the step or, with `whole_step`, anywhere
+  // over it: fills `point_move` with each point's largest distance from the reference, returns the
+  // bounds and sets `obstacle` to the obstacles' largest move from theirs.
+  const std::vector<double>& reference_bounds(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d* other, bool whole_step,
+                                              double& obstacle) {
+    const bool lin = lin_bounds_valid;
+    const Eigen::MatrixX3d& ref = lin ? lin_points : p0;
+    point_move = (points - ref).rowwise().norm();
+    if (other != nullptr) point_move = point_move.cwiseMax((*other - ref).rowwise().norm());
+    obstacle = (lin && !whole_step) || o0.rows() == 0 ? 0.0 : (o1 - o0).rowwise().norm().maxCoeff();
+    return lin ? lin_lower : cand_start_lower;
   }
 
   void begin_potential(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double step,
@@ -1657,38 +1717,42 @@ struct ContactStage::Impl {
     // thickness from where they were made for (their boxes are grown by twice the thickness).
     double off = 0.0;
     for (Eigen::Index i = 0; i < p1.rows(); ++i) off = std::max(off, (p1.row(i) - potential_guess.row(i)).norm());
-    if (off > 0.5 * settings.thickness || largest_move(p0, built_p0) > 0.5 * settings.thickness) {
+    if (off > serve_radius() || largest_move(p0, built_p0) > serve_radius()) {
       ContactReport scratch;
       make_potential_candidates(scratch);
     }
     const double dhat = settings.thickness;
-    // How far each surface point (and, at most, any obstacle vertex) moves over the step: a pair
-    // whose distance at the start exceeds the thickness by more than its points' motion cannot be
-    // within it at the end (most candidates of a slow or resting cloth).
-    point_motion.resize(p1.rows());
-    for (Eigen::Index i = 0; i < p1.rows(); ++i) point_motion(i) = (p1.row(i) - p0.row(i)).norm();
-    const double obstacle_motion = o0.rows() > 0 ? (o1 - o0).rowwise().norm().maxCoeff() : 0.0;
+    // A pair whose distance at the reference (the start, or the last linearisation) exceeds the
+    // thickness by more than its points have moved since cannot be within it now (most candidates
+    // of a slow or resting cloth); the bound each candidate gets here serves the next call.
+    double obstacle_motion = 0.0;
+    const std::vector<double>& lower = reference_bounds(p1, nullptr, false, obstacle_motion);
+    std::vector<double> new_lower(potential_cands.size(), 0.0);
     std::vector<char> active(potential_cands.size(), 0);
     end_geometry.resize(potential_cands.size());
     std::vector<PairGeometry>& end = end_geometry;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const Candidate& c = potential_cands[i];
-        if (c.near) continue;
-        double largest = 0.0;  // of the pair's cloth points
-        for (int q : cloth_points_of(c))
-          if (q >= 0) largest = std::max(largest, point_motion(q));
-        const bool cloth_cloth = c.kind == Kind::cloth_point_cloth_triangle || c.kind == Kind::cloth_edge_cloth_edge;
-        const double relative = cloth_cloth ? 2.0 * largest : largest + obstacle_motion;  // bounds the pair's relative motion
-        if (cand_start_lower[i] - relative >= dhat) continue;
+        const double bound = lower[i] - pair_motion(c, point_move, obstacle_motion);
+        new_lower[i] = std::max(0.0, bound);
+        if (bound >= dhat) continue;
         const std::array<Eigen::Vector3d, 4> corner = corners(c, true);
-        if (!within_boxes(corner, is_point_triangle(c.kind), dhat)) continue;  // (most candidates: no exact distance)
+        const double gap = box_gap(corner, is_point_triangle(c.kind));
+        new_lower[i] = std::max(new_lower[i], gap);
+        if (c.near || gap > dhat) continue;  // (most candidates: no exact distance)
         end[i] = geometry(c, corner);
+        new_lower[i] = std::max(new_lower[i], end[i].distance);
         if (redundant_on_flat_face(c, end[i], corner)) continue;
         if (end[i].distance < dhat) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
         active[i] = end[i].distance < dhat;
       }
     });
+    lin_lower = std::move(new_lower);
+    lin_points = p1;
+    lin_velocity = v;
+    lin_time = t + h;
+    lin_bounds_valid = true;
     auto add_pair = [&](const Constraint& c, double distance, double k) {
       const contact::CubicBarrier barrier{dhat, k};
       out.energy += barrier.value(distance);
@@ -1734,8 +1798,9 @@ struct ContactStage::Impl {
   }
 
   double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
-    const Eigen::MatrixX3d pa = end_points_of(from), pb = end_points_of(to);
-    const double half = 0.5 * settings.thickness;
+    const bool at_linearisation = lin_bounds_valid && from.size() == lin_velocity.size() && from == lin_velocity;
+    const Eigen::MatrixX3d pa = at_linearisation ? lin_points : end_points_of(from), pb = end_points_of(to);
+    const double half = serve_radius();
     // Candidates for the move pa → pb: the potential's where both ends stay within half the
     // thickness of the end they were made for (the move in between does too), else a broad phase
     // over this move.
@@ -1771,13 +1836,18 @@ struct ContactStage::Impl {
     };
     const double eta = params.min_separation_ratio * settings.thickness;
     const double near_eta = params.near_separation_ratio * settings.thickness;
+    // With the potential's candidates, a pair whose distance bound at the reference exceeds the
+    // separation by more than its points move (to either end of the move) is skipped.
+    double obstacle_motion = 0.0;
+    const std::vector<double>* lower = cands == &potential_cands ? &reference_bounds(pa, &pb, false, obstacle_motion) : nullptr;
     std::vector<double> bound(cands->size(), 1.0);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cands->size(), 256), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t i = range.begin(); i != range.end(); ++i) {
         const Candidate& c = (*cands)[i];
+        double separation = c.near ? near_eta : eta;
+        if (lower != nullptr && (*lower)[i] - pair_motion(c, point_move, obstacle_motion) > separation) continue;
         const std::array<Eigen::Vector3d, 4> a = corner(c, pa), b = corner(c, pb);
         const bool pt = is_point_triangle(c.kind);
-        double separation = c.near ? near_eta : eta;
         // A quick reject: the boxes of the swept primitives farther apart than the separation.
         std::array<Eigen::Vector3d, 4> lo, hi;
         for (size_t k = 0; k < 4; ++k) {
@@ -1876,12 +1946,14 @@ struct ContactStage::Impl {
     const double eta = params.min_separation_ratio * settings.thickness;
     std::vector<Candidate> cands;
     bool cands_current = true;  // made for the current end points
+    bool use_bounds = false;    // cands are the potential's, with their distance bounds
     if (potential_on) {
       // Proximity is the potential's, inside the step (begin_potential / linearise); here only the
       // fail-safe, on the potential's candidates where they serve this step's motion
       // (candidates_serve).
       if (candidates_serve()) {
         cands = potential_cands;
+        use_bounds = true;
       } else {
         candidate_grow = 0.0;
         cands = candidates(report);
@@ -1910,7 +1982,11 @@ struct ContactStage::Impl {
       report.narrow_ms += ms_since(t0);
       if (!cands_current || changed) cands = candidates(report);
       cands_current = false;  // the response below moves the end points
-      if (pass == 0) {
+      if (pass == 0 && use_bounds) {
+        double obstacle_motion = 0.0;
+        const std::vector<double>& lower = reference_bounds(p0, &p1, true, obstacle_motion);
+        hits = collisions(cands, t, report, nullptr, nullptr, &last_hits, &lower, obstacle_motion);
+      } else if (pass == 0) {
         hits = collisions(cands, t, report, nullptr, nullptr, &last_hits);
       } else {
         moved.assign(static_cast<size_t>(p1.rows()), 0);
@@ -1982,8 +2058,8 @@ bool ContactStage::potential_enabled() const { return impl_->potential_on; }
 
 void ContactStage::begin_step(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double h,
                               const Eigen::VectorXd& diagonal) {
-  impl_->begin_potential(x, v_guess, t, h, diagonal);
   impl_->potential_t = t;
+  impl_->begin_potential(x, v_guess, t, h, diagonal);
 }
 
 void ContactStage::linearise(const Eigen::VectorXd& v, PotentialLinearisation& out) {
