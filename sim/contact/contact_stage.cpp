@@ -1433,6 +1433,59 @@ struct ContactStage::Impl {
     return row;
   }
 
+  // Per surface point, its row of J in node form with the nodes sorted (made by enable_potential;
+  // empty rows when some point's row does not have that form, and pair_row takes the long way).
+  std::vector<NodeRow> point_rows;
+  bool point_rows_in_node_form = false;
+  void make_point_rows() {
+    point_rows.assign(static_cast<size_t>(rest_points.rows()), NodeRow{});
+    point_rows_in_node_form = true;
+    for (Eigen::Index p = 0; p < rest_points.rows(); ++p) {
+      NodeRow row = node_row(point_constraint(static_cast<int>(p), Eigen::Vector3d::UnitZ()));
+      if (!row.dofs.empty()) {
+        point_rows_in_node_form = false;
+        point_rows.clear();
+        return;
+      }
+      std::sort(row.nodes.begin(), row.nodes.end());
+      point_rows[static_cast<size_t>(p)] = std::move(row);
+    }
+  }
+  // The row of a pair's relative position over the nodes, Σ_k c_k J_k (cloth points only).
+  NodeRow pair_row(const PairGeometry& g) {
+    if (!point_rows_in_node_form) return node_row(constraint(g));
+    NodeRow row;
+    for (int k = 0; k < g.num; ++k) {
+      const double coef = g.coef[static_cast<size_t>(k)];
+      if (g.obstacle[static_cast<size_t>(k)] || coef == 0.0) continue;
+      for (const auto& [node, w] : point_rows[static_cast<size_t>(g.point[static_cast<size_t>(k)])].nodes) {
+        int& s = slot[static_cast<size_t>(3 * node)];
+        if (s < 0) {
+          s = static_cast<int>(row.nodes.size());
+          row.nodes.emplace_back(node, 0.0);
+        }
+        row.nodes[static_cast<size_t>(s)].second += coef * w;
+      }
+    }
+    for (const auto& entry : row.nodes) slot[static_cast<size_t>(3 * entry.first)] = -1;
+    std::sort(row.nodes.begin(), row.nodes.end());
+    return row;
+  }
+  // The obstacle side's part of a pair's relative velocity over the step [m/s].
+  Eigen::Vector3d obstacle_side_velocity(const PairGeometry& g) const {
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    for (int k = 0; k < g.num; ++k)
+      if (g.obstacle[static_cast<size_t>(k)]) {
+        const int p = g.point[static_cast<size_t>(k)];
+        u += g.coef[static_cast<size_t>(k)] * (o1.row(p) - o0.row(p)).transpose() / h;
+      }
+    return u;
+  }
+  double pair_friction(const PairGeometry& g) const {
+    const int o = obstacle_of(g);
+    return o >= 0 ? obstacles[static_cast<size_t>(o)].friction : settings.friction;
+  }
+
   // The barrier's stiffness for a pair of cloth points: k h² = ratio × the smallest effective
   // mass (with the step's stiffness, s_k) of its cloth points, so the barrier is as stiff as the
   // step's own system is under it, whatever the material and step.
@@ -1591,6 +1644,8 @@ struct ContactStage::Impl {
   Eigen::VectorXd lin_velocity;     // ... and the velocities they were made from
   bool lin_bounds_valid = false;    // lin_lower holds for this step's candidates
   double lin_time = -1.0;           // the time of lin_points (the end of its step) [s]
+  Eigen::VectorXd bound_to_velocity;  // the last step bound's velocities at the end of its move
+  Eigen::MatrixX3d bound_to_points;   // ... and their end points
   Eigen::VectorXd point_move;       // scratch: per surface point, its move from the reference [m]
 
   // How much a pair's distance can change when each of its cloth points p moves by at most
@@ -1659,7 +1714,8 @@ struct ContactStage::Impl {
     for (size_t i = 0; i < potential_cands.size(); ++i) {
       if (!cand_start_close[i]) continue;
       const contact::CubicBarrier barrier{settings.thickness, cand_stiffness[i]};
-      add_friction_row(constraint(cand_start[i]), -barrier.first(cand_start[i].distance));
+      const PairGeometry& g = cand_start[i];
+      add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(g), -barrier.first(g.distance), [&] { return pair_row(g); });
     }
     for (int k : planes) {
       const Obstacle& o = obstacles[static_cast<size_t>(k)];
@@ -1670,11 +1726,8 @@ struct ContactStage::Impl {
         const Eigen::Vector3d a = p0.row(p).transpose();
         const double dist = n0.dot(a - q0);
         if (!(dist < settings.thickness)) continue;
-        Constraint c = point_constraint(static_cast<int>(p), n0);
-        c.mu = o.friction;
-        c.obstacle_velocity = -(move(a) - a) / h;
         const contact::CubicBarrier barrier{settings.thickness, plane_stiffness[static_cast<size_t>(p)]};
-        add_friction_row(c, -barrier.first(dist));
+        add_friction_row(n0, o.friction, -(move(a) - a) / h, -barrier.first(dist), [&] { return point_row(static_cast<int>(p)); });
       }
     }
   }
@@ -1689,13 +1742,22 @@ struct ContactStage::Impl {
     return constraint(g);
   }
 
-  void add_friction_row(const Constraint& c, double lambda) {
-    if (!(c.mu > 0) || !(lambda > 0)) return;
+  // The row of one surface point (a plane's pair).
+  NodeRow point_row(int p) {
+    return point_rows_in_node_form ? point_rows[static_cast<size_t>(p)] : node_row(point_constraint(p, Eigen::Vector3d::UnitZ()));
+  }
+
+  // A lagged friction row for a pair with normal n, friction coefficient mu, the obstacle side's
+  // velocity and normal force lambda [N]; `row` makes the pair's row (only when it is needed).
+  template <class MakeRow>
+  void add_friction_row(const Eigen::Vector3d& normal, double mu, const Eigen::Vector3d& obstacle_velocity, double lambda,
+                        MakeRow row) {
+    if (!(mu > 0) || !(lambda > 0)) return;
     FrictionRow f;
-    f.row = node_row(c);
-    f.constant = c.obstacle_velocity;
-    f.tangent -= c.normal * c.normal.transpose();
-    f.bound = c.mu * lambda;
+    f.row = row();
+    f.constant = obstacle_velocity;
+    f.tangent -= normal * normal.transpose();
+    f.bound = mu * lambda;
     friction_rows.push_back(std::move(f));
   }
 
@@ -1710,7 +1772,12 @@ struct ContactStage::Impl {
     out.dissipation_gradient.setZero(n3);
     if (!(v.size() == p1_velocity.size() && v == p1_velocity)) {
       end_points_current = false;
-      update_end_points(v);
+      if (v.size() == bound_to_velocity.size() && v == bound_to_velocity) {
+        p1 = bound_to_points;  // (the last step bound's end of the move: Newton's next iterate)
+        end_points_current = true;
+      } else {
+        update_end_points(v);
+      }
       p1_velocity = v;
     }
     // Candidates made for other end points serve while no point is more than half the
@@ -1753,13 +1820,13 @@ struct ContactStage::Impl {
     lin_velocity = v;
     lin_time = t + h;
     lin_bounds_valid = true;
-    auto add_pair = [&](const Constraint& c, double distance, double k) {
+    auto add_pair = [&](NodeRow row, const Eigen::Vector3d& normal, double distance, double k) {
       const contact::CubicBarrier barrier{dhat, k};
       out.energy += barrier.value(distance);
       PotentialLinearisation::Block block;
-      block.row = node_row(c);
-      block.row.scatter(barrier.first(distance) * c.normal, out.energy_gradient);
-      block.hessian = barrier.second(distance) * c.normal * c.normal.transpose();
+      block.row = std::move(row);
+      block.row.scatter(barrier.first(distance) * normal, out.energy_gradient);
+      block.hessian = barrier.second(distance) * normal * normal.transpose();
       out.blocks.push_back(std::move(block));
       ++out.active;
     };
@@ -1768,13 +1835,13 @@ struct ContactStage::Impl {
     // over a face has several triangles within the thickness, and none of them twice).
     keep_closest(active, end);
     for (size_t i = 0; i < potential_cands.size(); ++i)
-      if (active[i]) add_pair(constraint(end[i]), end[i].distance, cand_stiffness[i]);
+      if (active[i]) add_pair(pair_row(end[i]), end[i].normal, end[i].distance, cand_stiffness[i]);
     for (int k : planes) {
       Eigen::Vector3d q1, n1;
       plane_at(obstacles[static_cast<size_t>(k)], t + h, q1, n1);
       for (Eigen::Index p = 0; p < p1.rows(); ++p) {
         const double dist = n1.dot(p1.row(p).transpose() - q1);
-        if (dist < dhat) add_pair(point_constraint(static_cast<int>(p), n1), dist, plane_stiffness[static_cast<size_t>(p)]);
+        if (dist < dhat) add_pair(point_row(static_cast<int>(p)), n1, dist, plane_stiffness[static_cast<size_t>(p)]);
       }
     }
     const contact::SmoothedFriction friction{friction_epsilon()};
@@ -1800,6 +1867,8 @@ struct ContactStage::Impl {
   double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
     const bool at_linearisation = lin_bounds_valid && from.size() == lin_velocity.size() && from == lin_velocity;
     const Eigen::MatrixX3d pa = at_linearisation ? lin_points : end_points_of(from), pb = end_points_of(to);
+    bound_to_velocity = to;
+    bound_to_points = pb;
     const double half = serve_radius();
     // Candidates for the move pa → pb: the potential's where both ends stay within half the
     // thickness of the end they were made for (the move in between does too), else a broad phase
@@ -2053,7 +2122,10 @@ ContactReport ContactStage::filter(const Eigen::VectorXd& x, double t, double h,
   return impl_->filter(x, t, h, v, system);
 }
 
-void ContactStage::enable_potential() { impl_->potential_on = true; }
+void ContactStage::enable_potential() {
+  impl_->potential_on = true;
+  impl_->make_point_rows();
+}
 bool ContactStage::potential_enabled() const { return impl_->potential_on; }
 
 void ContactStage::begin_step(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double h,

@@ -123,7 +123,8 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
     symmetric_product(a, w, ones, product);
     return 0.5 * w.dot(product) - b.dot(w) + l.energy + h * l.dissipation;
   };
-  double phi = merit(v, lin);
+  double phi = 0.0;
+  bool phi_known = false;  // (Φ is needed once the potential is something at either end of a step)
   LinearSolveReport total;
   total.converged = true;
   Eigen::VectorXd rhs(n3), v_new(n3), trial(n3), gradient(n3), estimate(n3);
@@ -176,6 +177,14 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
     // crossings).
     t0 = clock();
     potential_->linearise(v_new, next);
+    if (lin.empty() && next.empty()) {
+      // Nothing at either end: the solve minimised Φ, which is the step's quadratic there.
+      potential_ms += ms_since(t0);
+      v = v_new;
+      break;
+    }
+    if (!phi_known) phi = merit(v, lin);
+    phi_known = true;
     double phi_new = merit(v_new, next);
     auto raises = [&](double value) { return value > phi + 1e-12 * std::abs(phi); };
     for (int halve = 0; halve < 8 && raises(phi_new); ++halve) {
@@ -192,19 +201,16 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
     }
     // Converged when the next Newton step, estimated with the solver's preconditioner (a factor
     // of this or an earlier Newton matrix) from the gradient of Φ at v_new, is below the
-    // tolerance: the step just taken may be small only because the model was stiff. With no
-    // potential at either end the solve was exact.
+    // tolerance: the step just taken may be small only because the model was stiff.
+    gradient = product - b;  // (product = A v_new: merit() was last called at v_new)
+    if (next.energy_gradient.size() == n3) gradient += h * next.energy_gradient;
+    if (next.dissipation_gradient.size() == n3) gradient += h * next.dissipation_gradient;
+    for (Eigen::Index i = 0; i < n3; ++i)
+      if (!free_[static_cast<size_t>(i)]) gradient(i) = 0.0;
+    solver_.preconditioner(coupled_.matrix(), free_)(gradient, estimate);
     double change = 0.0;
-    if (!(lin.empty() && next.empty())) {
-      gradient = product - b;  // (product = A v_new: merit() was last called at v_new)
-      if (next.energy_gradient.size() == n3) gradient += h * next.energy_gradient;
-      if (next.dissipation_gradient.size() == n3) gradient += h * next.dissipation_gradient;
-      for (Eigen::Index i = 0; i < n3; ++i)
-        if (!free_[static_cast<size_t>(i)]) gradient(i) = 0.0;
-      solver_.preconditioner(coupled_.matrix(), free_)(gradient, estimate);
-      for (Eigen::Index i = 0; i < n3; ++i)
-        if (free_[static_cast<size_t>(i)]) change = std::max(change, std::abs(estimate(i)));
-    }
+    for (Eigen::Index i = 0; i < n3; ++i)
+      if (free_[static_cast<size_t>(i)]) change = std::max(change, std::abs(estimate(i)));
     v = v_new;
     std::swap(lin, next);
     phi = phi_new;

@@ -114,8 +114,10 @@ void CoupledMatrix::add_block(const NodeRow& row, const Eigen::Matrix3d& h) {
   if (row.dofs.empty()) {
     // Node form: Bₚᵀ H B_q = w_p w_q H. With the nodes sorted, each node's ranks among the
     // others' couplings are found by one merge.
-    std::vector<std::pair<int, double>> weights(row.nodes.begin(), row.nodes.end());
-    std::sort(weights.begin(), weights.end());
+    std::vector<std::pair<int, double>> sorted;
+    const bool in_order = std::is_sorted(row.nodes.begin(), row.nodes.end());
+    if (!in_order) sorted.assign(row.nodes.begin(), row.nodes.end()), std::sort(sorted.begin(), sorted.end());
+    const std::vector<std::pair<int, double>>& weights = in_order ? row.nodes : sorted;
     for (const auto& [q, wq] : weights) {
       const Eigen::Matrix3d hq = h * wq;
       const std::vector<int>& coupled = adjacency_[static_cast<size_t>(q)];
