@@ -12,6 +12,7 @@
 #include "app/output_folders.hpp"
 #include "render/renderer.hpp"
 
+#include "sim/contact/obstacle.hpp"
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/scene/render_settings_json.hpp"
@@ -278,6 +279,30 @@ class Outputs {
                         drawn_surface_description(scene_.problem.method, scene_.render.surface, scene_.obj_level) +
                         ")",
                     &n);
+        }
+        // The obstacles (every one but planes) as they stand at this frame, as the contact sees them:
+        // `check_intersections mesh_NNNN.obj obstacles_NNNN.obj` checks a frame against them.
+        std::vector<const Obstacle*> meshes;
+        for (const Obstacle& o : scene_.problem.obstacles)
+          if (o.shape != Obstacle::Shape::plane && o.mesh.num_triangles() > 0) meshes.push_back(&o);
+        if (!meshes.empty()) {
+          Eigen::Index rows = 0;
+          for (const Obstacle* o : meshes) rows += o->mesh.vertices.rows();
+          Eigen::MatrixX3d vertices(rows, 3);
+          std::vector<Triangle> triangles;
+          Eigen::Index offset = 0;
+          std::string names;
+          for (const Obstacle* o : meshes) {
+            vertices.middleRows(offset, o->mesh.vertices.rows()) = mesh_at(*o, t);
+            for (const Triangle& tri : o->mesh.triangles)
+              triangles.push_back({tri[0] + static_cast<int>(offset), tri[1] + static_cast<int>(offset), tri[2] + static_cast<int>(offset)});
+            offset += o->mesh.vertices.rows();
+            names += (names.empty() ? "" : ", ") + o->name;
+          }
+          std::snprintf(file, sizeof(file), "obstacles_%04d.obj", totals.frames);
+          write_obj((dir_ / "frames" / file).string(), vertices, triangles,
+                    "clothsim: obstacles of scene " + scene_.name + " (" + names + "), frame " + std::to_string(totals.frames) +
+                        ", t = " + format_double(t) + " s");
         }
       }
       if (images_) {
@@ -553,6 +578,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
       if (scene.write_obj_frames) {
         fs::create_directories(dir / "frames");
         remove_from(dir / "frames", "mesh_", ".obj", frames);
+        remove_from(dir / "frames", "obstacles_", ".obj", frames);
         remove_temporary_files(dir / "frames");
       }
       remove_temporary_files(dir);

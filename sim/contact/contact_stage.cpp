@@ -72,6 +72,26 @@ struct Candidate {
   bool operator==(const Candidate& o) const { return kind == o.kind && a == o.a && b == o.b; }
 };
 
+// Lower bounds of the distances of a list of candidate pairs at some configuration
+// (ContactStage::Impl::reference_bounds), and those below a reach.
+struct Bounds {
+  std::vector<double> lower;    // per candidate [m]
+  std::vector<size_t> close;    // the candidates whose bound is below `reach`
+  double reach = 0.0;           // [m]
+  void make_close(double r) {
+    reach = r;
+    close.clear();
+    for (size_t i = 0; i < lower.size(); ++i)
+      if (lower[i] < r) close.push_back(i);
+  }
+  // The bounds less `motion` (at least 0): the bounds after every point moved by at most that.
+  std::vector<double> less(double motion) const {
+    std::vector<double> out(lower.size());
+    for (size_t i = 0; i < lower.size(); ++i) out[i] = std::max(0.0, lower[i] - motion);
+    return out;
+  }
+};
+
 // Geometry of one pair at one instant: up to four points on each side with coefficients
 // (relative position = Σ c_k p_k, cloth points first), a unit normal from the second primitive
 // to the first, and their distance.
@@ -169,6 +189,10 @@ struct ContactStage::Impl {
   std::vector<Triangle> obstacle_triangles;
   std::vector<std::array<int, 2>> obstacle_edges;
   std::vector<char> obstacle_edge_flat, obstacle_vertex_flat;  // between coplanar triangles; all edges flat
+  // tan(θ / 2) of the angle θ between the normals of an edge's two triangles (infinite for an edge
+  // with one or more than two), and per vertex the largest of its edges': see
+  // measure_smooth_tangents().
+  std::vector<double> obstacle_edge_tangent, obstacle_vertex_tangent;
   std::vector<std::array<int, 3>> obstacle_triangle_edges;
   std::vector<std::vector<int>> obstacle_owned_points, obstacle_owned_edges;
   std::vector<int> obstacle_of_vertex;  // obstacle index per combined vertex
@@ -299,10 +323,16 @@ struct ContactStage::Impl {
       return Eigen::Vector3d((b - a).cross(c - a));
     };
     std::vector<char> flat(obstacle_edges.size(), 0);
+    obstacle_edge_tangent.assign(obstacle_edges.size(), std::numeric_limits<double>::infinity());
+    obstacle_vertex_tangent.assign(obstacle_of_vertex.size(), 0.0);
     for (size_t e = 0; e < obstacle_edges.size(); ++e) {
-      if (edge_triangles[e].size() != 2) continue;
-      const Eigen::Vector3d n1 = normal(edge_triangles[e][0]), n2 = normal(edge_triangles[e][1]);
-      flat[e] = n1.dot(n2) > 0 && n1.cross(n2).norm() <= 1e-12 * n1.norm() * n2.norm();
+      if (edge_triangles[e].size() == 2) {
+        const Eigen::Vector3d n1 = normal(edge_triangles[e][0]), n2 = normal(edge_triangles[e][1]);
+        flat[e] = n1.dot(n2) > 0 && n1.cross(n2).norm() <= 1e-12 * n1.norm() * n2.norm();
+        obstacle_edge_tangent[e] = std::tan(0.5 * std::atan2(n1.cross(n2).norm(), n1.dot(n2)));
+      }
+      for (int v : obstacle_edges[e])
+        obstacle_vertex_tangent[static_cast<size_t>(v)] = std::max(obstacle_vertex_tangent[static_cast<size_t>(v)], obstacle_edge_tangent[e]);
     }
     for (std::vector<int>& owned : obstacle_owned_edges)
       owned.erase(std::remove_if(owned.begin(), owned.end(), [&](int e) { return flat[static_cast<size_t>(e)] != 0; }), owned.end());
@@ -311,6 +341,38 @@ struct ContactStage::Impl {
     for (size_t e = 0; e < obstacle_edges.size(); ++e)
       if (!flat[e])
         for (int v : obstacle_edges[e]) obstacle_vertex_flat[static_cast<size_t>(v)] = 0;
+  }
+
+  // Obstacle edges and vertices that bend the obstacle's surface little make no pairs with a
+  // cloth triangle (obstacle vertex–cloth triangle) or a cloth edge (cloth edge–obstacle edge)
+  // near them: the cloth points' pairs with the obstacle's triangles keep them clear. A flat
+  // piece of the cloth surface (a fine triangle, its longest edge L) whose corners are at least a
+  // distance s from both triangles of an obstacle edge that bends by θ comes no closer to the
+  // edge than s − (L / 2) tan(θ / 2), where it lies across the edge; with (L / 2) tan(θ / 2) at
+  // most half the CCD's minimum separation η, corners kept η away keep the edge η / 2 away. So on
+  // a finely tessellated smooth obstacle (a capsule at 5°) most of its edges and vertices need no
+  // pairs. smooth_tangent holds, per fine triangle (and per fine edge: the larger of its
+  // triangles'), the largest tan(θ / 2) that allows, with L measured at the start and end of the
+  // step (so it follows stretching).
+  std::vector<double> smooth_tangent_triangle, smooth_tangent_edge;
+  void measure_smooth_tangents() {
+    const double eta = params.min_separation_ratio * settings.thickness;
+    smooth_tangent_triangle.resize(surface.triangles.size());
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, surface.triangles.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        double longest = 0.0;
+        const auto& t = surface.triangles[i];
+        for (int k = 0; k < 3; ++k) {
+          const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
+          longest = std::max({longest, (p0.row(a) - p0.row(b)).squaredNorm(), (p1.row(a) - p1.row(b)).squaredNorm()});
+        }
+        smooth_tangent_triangle[i] = longest > 0 ? eta / std::sqrt(longest) : std::numeric_limits<double>::infinity();
+      }
+    });
+    smooth_tangent_edge.assign(edges.size(), std::numeric_limits<double>::infinity());
+    for (size_t i = 0; i < surface.triangles.size(); ++i)
+      for (int e : triangle_edges[i])
+        smooth_tangent_edge[static_cast<size_t>(e)] = std::min(smooth_tangent_edge[static_cast<size_t>(e)], smooth_tangent_triangle[i]);
   }
 
   // A point–obstacle-triangle pair adds nothing when the point's closest point on the triangle
@@ -738,6 +800,7 @@ struct ContactStage::Impl {
         }
         obstacle_boxes_current = true;
       }
+      measure_smooth_tangents();
       for (const auto& [q, j] : obstacle_broad.pairs(patch_box, obstacle_boxes))
         for (int i = q * fine_per_patch; i < (q + 1) * fine_per_patch; ++i) {
           if (!overlap(grown(triangle_box(i), grow), obstacle_boxes[static_cast<size_t>(j)])) continue;
@@ -745,11 +808,12 @@ struct ContactStage::Impl {
             if (overlap(point_grown[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
               out.push_back({Kind::cloth_point_obstacle_triangle, v, j});
           for (int v : obstacle_owned_points[static_cast<size_t>(j)])
-            if (overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), triangle_box(i)))
+            if (obstacle_vertex_tangent[static_cast<size_t>(v)] > smooth_tangent_triangle[static_cast<size_t>(i)] &&
+                overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), triangle_box(i)))
               out.push_back({Kind::obstacle_point_cloth_triangle, v, i});
           for (int ea : owned_edges[static_cast<size_t>(i)])
             for (int eb : obstacle_owned_edges[static_cast<size_t>(j)])
-              if (overlap(edge_swept(ea), obstacle_edge_box[static_cast<size_t>(eb)]))
+              if (obstacle_edge_tangent[static_cast<size_t>(eb)] > smooth_tangent_edge[static_cast<size_t>(ea)] && overlap(edge_swept(ea), obstacle_edge_box[static_cast<size_t>(eb)]))
                 out.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
         }
     }
@@ -1022,12 +1086,13 @@ struct ContactStage::Impl {
   // (per surface point: its end position changed since the last test) and `last` (the pairs
   // that collided then, sorted), only pairs with a moved point or a previous collision are
   // tested again: the others have the same positions, so the same (negative) answer. With
-  // `lower` (per candidate, a bound of its distance at a reference, see reference_bounds, which
-  // fills point_move), pairs that cannot come within the separation are not tested.
+  // `bounds` (the potential's candidates' distance bounds at a reference, from reference_bounds,
+  // which fills point_move and gives `motion`), pairs that cannot come within the separation are
+  // not tested.
   std::vector<Found> collisions(const std::vector<Candidate>& cands, double t, ContactReport& report,
                                 const std::vector<char>* moved = nullptr, const std::vector<Candidate>* last = nullptr,
-                                std::vector<Candidate>* hit_pairs = nullptr, const std::vector<double>* lower = nullptr,
-                                double obstacle_motion = 0.0) {
+                                std::vector<Candidate>* hit_pairs = nullptr, const Bounds* bounds = nullptr,
+                                double obstacle_motion = 0.0, double motion = 0.0) {
     const auto t0 = Clock::now();
     const double eta = params.min_separation_ratio * settings.thickness;
     std::vector<Found> out;
@@ -1035,9 +1100,13 @@ struct ContactStage::Impl {
     // The CCD of every pair in parallel (each pair alone), then the hits in the pairs' order.
     std::vector<double> toi(cands.size(), -1.0);  // −1: not tested or no hit
     std::atomic<long long> tested{0};
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+    const std::vector<double>* lower = bounds != nullptr ? &bounds->lower : nullptr;
+    const bool close_only = bounds != nullptr && bounds->reach - motion >= std::max(eta, params.near_separation_ratio * settings.thickness);
+    const size_t n = close_only ? bounds->close.size() : cands.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
       long long count = 0;
-      for (size_t i = range.begin(); i != range.end(); ++i) {
+      for (size_t j = range.begin(); j != range.end(); ++j) {
+        const size_t i = close_only ? bounds->close[j] : j;
         const Candidate& c = cands[i];
         const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
         if (lower != nullptr && (*lower)[i] - pair_motion(c, point_move, obstacle_motion) > separation) continue;
@@ -1407,7 +1476,6 @@ struct ContactStage::Impl {
   double candidate_grow = 0.0;              // > 0: the broad phase's growth instead of the thickness [m]
   std::vector<Candidate> potential_cands;   // this step's candidates (boxes grown by 2 d̂)
   Eigen::MatrixX3d potential_guess;         // the end points they were made for
-  std::vector<double> cand_stiffness;       // the barrier's k per candidate [N/m]
   std::vector<double> plane_stiffness;      // per surface point, against planes [N/m]
   Eigen::VectorXd point_mass;               // per surface point: 1 / Σ_k J_k² / s_k [kg]
   struct FrictionRow {
@@ -1527,17 +1595,19 @@ struct ContactStage::Impl {
     built_o1 = o1;
     prepare_candidates();
   }
-  // Per step (and after a new broad phase): each candidate's barrier stiffness and geometry at
-  // the start of the step.
+  // Per step (and after a new broad phase): each candidate's distance bound and, where it may be
+  // within the thickness, geometry at the start of the step.
   void prepare_candidates() {
     // The last step's final linearisation holds bounds at its end points, the obstacles at its
     // end: this step's start (the same surface up to the fail-safe's changes and round-off, which
     // the points' moves from it account for).
-    const bool carried = lin_bounds_valid && lin_lower.size() == potential_cands.size() && lin_time == potential_t;
-    if (carried) point_move = (p0 - lin_points).rowwise().norm();
+    const bool carried = lin_bounds_valid && lin_bounds.lower.size() == potential_cands.size() && lin_time == potential_t;
+    double motion = 0.0;
+    if (carried) {
+      point_move = (p0 - lin_points).rowwise().norm();
+      motion = 2.0 * point_move.maxCoeff();
+    }
     lin_bounds_valid = false;
-    cand_stiffness.resize(potential_cands.size());
-    for (size_t i = 0; i < potential_cands.size(); ++i) cand_stiffness[i] = pair_stiffness(potential_cands[i]);
     // Each pair's geometry at the start of the step: its side (the barrier's distance is signed
     // by it, see linearise_potential) and, for pairs pressed at the start, lagged friction.
     // (Computed here for the pairs whose boxes are within the thickness at the start, the others
@@ -1545,26 +1615,34 @@ struct ContactStage::Impl {
     cand_start.resize(potential_cands.size());
     cand_start_known.assign(potential_cands.size(), 0);
     cand_start_close.assign(potential_cands.size(), 0);
-    cand_start_lower.assign(potential_cands.size(), 0.0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        const Candidate& c = potential_cands[i];
-        if (carried) {
-          const double bound = lin_lower[i] - pair_motion(c, point_move, 0.0);
-          cand_start_lower[i] = std::max(0.0, bound);
-          if (bound >= settings.thickness) continue;
-        }
-        const std::array<Eigen::Vector3d, 4> corner = corners(c, false);
-        const double gap = box_gap(corner, is_point_triangle(c.kind));
-        cand_start_lower[i] = std::max(cand_start_lower[i], gap);
-        if (c.near || !(gap < settings.thickness)) continue;
-        cand_start_lower[i] = start_geometry(i).distance;
-        cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face(c, cand_start[i], corner);
+    std::vector<double>& lower = start_bounds.lower;
+    if (carried) {
+      lower = lin_bounds.less(motion);
+    } else {
+      lower.assign(potential_cands.size(), 0.0);
+    }
+    auto visit = [&](size_t i) {
+      const Candidate& c = potential_cands[i];
+      if (carried) {
+        const double bound = lin_bounds.lower[i] - pair_motion(c, point_move, 0.0);
+        lower[i] = std::max(0.0, bound);
+        if (bound >= settings.thickness) return;
       }
-    });
+      const std::array<Eigen::Vector3d, 4> corner = corners(c, false);
+      const double gap = box_gap(corner, is_point_triangle(c.kind));
+      lower[i] = std::max(lower[i], gap);
+      if (c.near || !(gap < settings.thickness)) return;
+      lower[i] = start_geometry(i).distance;
+      cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face(c, cand_start[i], corner);
+    };
+    if (carried) {
+      for_candidates(lin_bounds, motion, settings.thickness, visit);
+    } else {
+      for_candidates(nullptr, 0.0, 0.0, visit);
+    }
+    start_bounds.make_close(close_reach());
   }
   std::vector<char> cand_start_known;
-  std::vector<double> cand_start_lower;  // a lower bound of each pair's distance at the start [m]
   // Candidate i's geometry at the start of the step (computed once per step; each i by one thread).
   const PairGeometry& start_geometry(size_t i) {
     if (!cand_start_known[i]) {
@@ -1636,13 +1714,30 @@ struct ContactStage::Impl {
 
   // Lower bounds of the candidates' distances at a reference configuration, so that a pair whose
   // points have moved less than its bound allows is known to be apart without looking at it: the
-  // step's start (p0 and the obstacles at t: cand_start_lower), or the end points of the last
-  // linearisation (obstacles at t + h: lin_lower). Most candidates of a resting or slowly moving
-  // cloth are decided this way in each linearisation and each step bound.
-  std::vector<double> lin_lower;    // per candidate, at lin_points [m]
+  // step's start (p0 and the obstacles at t: start_bounds), or the end points of the last
+  // linearisation (obstacles at t + h: lin_bounds). Most candidates of a resting or slowly moving
+  // cloth are decided this way in each linearisation and each step bound; while every pair moves
+  // less than a quarter of the thickness from the reference, only the candidates whose bound is
+  // within 1.25 thicknesses (`close`) are visited at all.
+  Bounds start_bounds, lin_bounds;
+  double close_reach() const { return 1.25 * settings.thickness; }
+  // Calls visit(i), in parallel, for every candidate, or only for the close ones of `bounds` when
+  // no pair can move from its bound to below `threshold` with moves of at most `motion` [m].
+  template <class Visit>
+  void for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit) {
+    const bool close_only = bounds != nullptr && bounds->reach - motion >= threshold;
+    const size_t n = close_only ? bounds->close.size() : potential_cands.size();
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t j = range.begin(); j != range.end(); ++j) visit(close_only ? bounds->close[j] : j);
+    });
+  }
+  template <class Visit>
+  void for_candidates(const Bounds& bounds, double motion, double threshold, Visit visit) {
+    for_candidates(&bounds, motion, threshold, visit);
+  }
   Eigen::MatrixX3d lin_points;      // the end points of the last linearisation
   Eigen::VectorXd lin_velocity;     // ... and the velocities they were made from
-  bool lin_bounds_valid = false;    // lin_lower holds for this step's candidates
+  bool lin_bounds_valid = false;    // lin_bounds hold for this step's candidates
   double lin_time = -1.0;           // the time of lin_points (the end of its step) [s]
   Eigen::VectorXd bound_to_velocity;  // the last step bound's velocities at the end of its move
   Eigen::MatrixX3d bound_to_points;   // ... and their end points
@@ -1668,15 +1763,18 @@ struct ContactStage::Impl {
   // The reference for surface points `points` (and `other`, when not null: any move between the
   // two), with the obstacles where they are at the end of the step or, with `whole_step`, anywhere
   // over it: fills `point_move` with each point's largest distance from the reference, returns the
-  // bounds and sets `obstacle` to the obstacles' largest move from theirs.
-  const std::vector<double>& reference_bounds(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d* other, bool whole_step,
-                                              double& obstacle) {
+  // bounds, sets `obstacle` to the obstacles' largest move from theirs and `motion` to the
+  // largest change of any pair's distance that these moves allow.
+  const Bounds& reference_bounds(const Eigen::MatrixX3d& points, const Eigen::MatrixX3d* other, bool whole_step, double& obstacle,
+                                 double& motion) {
     const bool lin = lin_bounds_valid;
     const Eigen::MatrixX3d& ref = lin ? lin_points : p0;
     point_move = (points - ref).rowwise().norm();
     if (other != nullptr) point_move = point_move.cwiseMax((*other - ref).rowwise().norm());
     obstacle = (lin && !whole_step) || o0.rows() == 0 ? 0.0 : (o1 - o0).rowwise().norm().maxCoeff();
-    return lin ? lin_lower : cand_start_lower;
+    const double largest = point_move.size() > 0 ? point_move.maxCoeff() : 0.0;
+    motion = std::max(2.0 * largest, largest + obstacle);
+    return lin ? lin_bounds : start_bounds;
   }
 
   void begin_potential(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double step,
@@ -1713,7 +1811,7 @@ struct ContactStage::Impl {
     keep_closest(cand_start_close, cand_start);
     for (size_t i = 0; i < potential_cands.size(); ++i) {
       if (!cand_start_close[i]) continue;
-      const contact::CubicBarrier barrier{settings.thickness, cand_stiffness[i]};
+      const contact::CubicBarrier barrier{settings.thickness, pair_stiffness(potential_cands[i])};
       const PairGeometry& g = cand_start[i];
       add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(g), -barrier.first(g.distance), [&] { return pair_row(g); });
     }
@@ -1792,30 +1890,31 @@ struct ContactStage::Impl {
     // A pair whose distance at the reference (the start, or the last linearisation) exceeds the
     // thickness by more than its points have moved since cannot be within it now (most candidates
     // of a slow or resting cloth); the bound each candidate gets here serves the next call.
-    double obstacle_motion = 0.0;
-    const std::vector<double>& lower = reference_bounds(p1, nullptr, false, obstacle_motion);
-    std::vector<double> new_lower(potential_cands.size(), 0.0);
+    double obstacle_motion = 0.0, motion = 0.0;
+    const Bounds& bounds = reference_bounds(p1, nullptr, false, obstacle_motion, motion);
+    // (The candidates not visited keep their bound less the largest motion.)
+    Bounds next;
+    next.lower = bounds.less(motion);
     std::vector<char> active(potential_cands.size(), 0);
     end_geometry.resize(potential_cands.size());
     std::vector<PairGeometry>& end = end_geometry;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, potential_cands.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        const Candidate& c = potential_cands[i];
-        const double bound = lower[i] - pair_motion(c, point_move, obstacle_motion);
-        new_lower[i] = std::max(0.0, bound);
-        if (bound >= dhat) continue;
-        const std::array<Eigen::Vector3d, 4> corner = corners(c, true);
-        const double gap = box_gap(corner, is_point_triangle(c.kind));
-        new_lower[i] = std::max(new_lower[i], gap);
-        if (c.near || gap > dhat) continue;  // (most candidates: no exact distance)
-        end[i] = geometry(c, corner);
-        new_lower[i] = std::max(new_lower[i], end[i].distance);
-        if (redundant_on_flat_face(c, end[i], corner)) continue;
-        if (end[i].distance < dhat) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
-        active[i] = end[i].distance < dhat;
-      }
+    for_candidates(bounds, motion, dhat, [&](size_t i) {
+      const Candidate& c = potential_cands[i];
+      const double bound = bounds.lower[i] - pair_motion(c, point_move, obstacle_motion);
+      next.lower[i] = std::max(0.0, bound);
+      if (bound >= dhat) return;
+      const std::array<Eigen::Vector3d, 4> corner = corners(c, true);
+      const double gap = box_gap(corner, is_point_triangle(c.kind));
+      next.lower[i] = std::max(next.lower[i], gap);
+      if (c.near || gap > dhat) return;  // (most candidates: no exact distance)
+      end[i] = geometry(c, corner);
+      next.lower[i] = std::max(next.lower[i], end[i].distance);
+      if (redundant_on_flat_face(c, end[i], corner)) return;
+      if (end[i].distance < dhat) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
+      active[i] = end[i].distance < dhat;
     });
-    lin_lower = std::move(new_lower);
+    next.make_close(close_reach());
+    lin_bounds = std::move(next);
     lin_points = p1;
     lin_velocity = v;
     lin_time = t + h;
@@ -1835,7 +1934,7 @@ struct ContactStage::Impl {
     // over a face has several triangles within the thickness, and none of them twice).
     keep_closest(active, end);
     for (size_t i = 0; i < potential_cands.size(); ++i)
-      if (active[i]) add_pair(pair_row(end[i]), end[i].normal, end[i].distance, cand_stiffness[i]);
+      if (active[i]) add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]));
     for (int k : planes) {
       Eigen::Vector3d q1, n1;
       plane_at(obstacles[static_cast<size_t>(k)], t + h, q1, n1);
@@ -1907,14 +2006,14 @@ struct ContactStage::Impl {
     const double near_eta = params.near_separation_ratio * settings.thickness;
     // With the potential's candidates, a pair whose distance bound at the reference exceeds the
     // separation by more than its points move (to either end of the move) is skipped.
-    double obstacle_motion = 0.0;
-    const std::vector<double>* lower = cands == &potential_cands ? &reference_bounds(pa, &pb, false, obstacle_motion) : nullptr;
+    double obstacle_motion = 0.0, motion = 0.0;
+    const Bounds* bounds = cands == &potential_cands ? &reference_bounds(pa, &pb, false, obstacle_motion, motion) : nullptr;
+    const std::vector<double>* lower = bounds != nullptr ? &bounds->lower : nullptr;
     std::vector<double> bound(cands->size(), 1.0);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, cands->size(), 256), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) {
+    auto visit = [&](size_t i) {
         const Candidate& c = (*cands)[i];
         double separation = c.near ? near_eta : eta;
-        if (lower != nullptr && (*lower)[i] - pair_motion(c, point_move, obstacle_motion) > separation) continue;
+        if (lower != nullptr && (*lower)[i] - pair_motion(c, point_move, obstacle_motion) > separation) return;
         const std::array<Eigen::Vector3d, 4> a = corner(c, pa), b = corner(c, pb);
         const bool pt = is_point_triangle(c.kind);
         // A quick reject: the boxes of the swept primitives farther apart than the separation.
@@ -1933,14 +2032,20 @@ struct ContactStage::Impl {
           lb = lb.cwiseMin(lo[k]);
           hb = hb.cwiseMax(hi[k]);
         }
-        if (!(((la.array() - separation) <= hb.array()).all() && ((lb.array() - separation) <= ha.array()).all())) continue;
+        if (!(((la.array() - separation) <= hb.array()).all() && ((lb.array() - separation) <= ha.array()).all())) return;
         const double start_distance = geometry(c, a).distance;
-        if (!(start_distance > 0)) continue;  // (touching already: nothing to bound)
+        if (!(start_distance > 0)) return;  // (touching already: nothing to bound)
         separation = std::min(separation, 0.5 * start_distance);
         const contact::CcdResult r = pt ? contact::point_triangle_ccd(a, b, separation) : contact::edge_edge_ccd(a, b, separation);
         if (r.hit) bound[i] = r.toi;
-      }
-    });
+    };
+    if (bounds != nullptr) {
+      for_candidates(*bounds, motion, std::max(eta, near_eta), visit);
+    } else {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, cands->size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t i = range.begin(); i != range.end(); ++i) visit(i);
+      });
+    }
     double alpha = 1.0;
     for (double b : bound) alpha = std::min(alpha, b);
     for (int k : planes) {
@@ -2052,9 +2157,9 @@ struct ContactStage::Impl {
       if (!cands_current || changed) cands = candidates(report);
       cands_current = false;  // the response below moves the end points
       if (pass == 0 && use_bounds) {
-        double obstacle_motion = 0.0;
-        const std::vector<double>& lower = reference_bounds(p0, &p1, true, obstacle_motion);
-        hits = collisions(cands, t, report, nullptr, nullptr, &last_hits, &lower, obstacle_motion);
+        double obstacle_motion = 0.0, motion = 0.0;
+        const Bounds& bounds = reference_bounds(p0, &p1, true, obstacle_motion, motion);
+        hits = collisions(cands, t, report, nullptr, nullptr, &last_hits, &bounds, obstacle_motion, motion);
       } else if (pass == 0) {
         hits = collisions(cands, t, report, nullptr, nullptr, &last_hits);
       } else {
