@@ -1565,25 +1565,38 @@ struct ContactStage::Impl {
   }
 
   // The potential's candidates: the broad phase over the motion p0 → p1 with boxes grown by twice
-  // the thickness. They serve every motion whose start and end points (and obstacle vertices)
-  // each stay within half the thickness of the ones they were made for: at any time of such a
-  // motion every point is within that of the old one, so each pair that comes within the
-  // thickness at the end (the barrier) or within the thickness over the step (the fail-safe's
-  // CCD) is among them. So they are kept from step to step while the cloth moves little (a
-  // resting drape), and made again when it moves on.
+  // the thickness. They serve every configuration, and every motion between two, whose points
+  // (and obstacle vertices) each stay within half the thickness of the straight path from the
+  // start to the end point they were made for: at any time of such a motion every point is within
+  // that of its swept box, so each pair that comes within the thickness at the end (the barrier),
+  // over the step (the fail-safe's CCD) or over a Newton step (step_bound) is among them. So they
+  // are kept from step to step while the cloth moves little (a resting drape), and from the
+  // held start to the guess and on through Newton's iterates within a step.
   Eigen::MatrixX3d built_p0, built_o0, built_o1;  // the motion they were made for (and potential_guess)
   // (Half the thickness. A radius of 1 or 2.5 thicknesses took 2.2 or 9.6 times the contact time
   // on sleeve_on_arm's first 0.6 s: the candidates grow faster than their rebuilds get rarer.)
   double serve_radius() const { return 0.5 * settings.thickness; }
-  static double largest_move(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
-    if (a.rows() != b.rows()) return std::numeric_limits<double>::infinity();
-    return a.rows() == 0 ? 0.0 : (a - b).rowwise().norm().maxCoeff();
+  // The largest distance of a point p_i from the segment a_i → b_i [m] (infinite for other sizes).
+  static double sweep_distance(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+    if (p.rows() != a.rows() || p.rows() != b.rows()) return std::numeric_limits<double>::infinity();
+    double worst = 0.0;
+    for (Eigen::Index i = 0; i < p.rows(); ++i) {
+      const Eigen::RowVector3d d = b.row(i) - a.row(i), q = p.row(i) - a.row(i);
+      const double dd = d.squaredNorm();
+      const double s = dd > 0 ? std::clamp(q.dot(d) / dd, 0.0, 1.0) : 0.0;
+      worst = std::max(worst, (q - s * d).squaredNorm());
+    }
+    return std::sqrt(worst);
   }
-  bool candidates_serve() const {
-    const double half = serve_radius();
-    return largest_move(p0, built_p0) <= half && largest_move(p1, potential_guess) <= half &&
-           largest_move(o0, built_o0) <= half && largest_move(o1, built_o1) <= half;
+  // Whether the candidates serve surface points p (and, when not null, q: any move between the
+  // two) with the obstacle vertices o (and, when not null, any move from `o_from` to them).
+  bool candidates_serve(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d* q, const Eigen::MatrixX3d& o,
+                        const Eigen::MatrixX3d* o_from) const {
+    const double r = serve_radius();
+    return sweep_distance(p, built_p0, potential_guess) <= r && (q == nullptr || sweep_distance(*q, built_p0, potential_guess) <= r) &&
+           sweep_distance(o, built_o0, built_o1) <= r && (o_from == nullptr || sweep_distance(*o_from, built_o0, built_o1) <= r);
   }
+  bool candidates_serve() const { return candidates_serve(p0, &p1, o0, &o1); }
   void make_potential_candidates(ContactReport& report) {
     lin_bounds_valid = false;
     candidate_grow = settings.thickness + 2.0 * serve_radius();
@@ -1879,10 +1892,8 @@ struct ContactStage::Impl {
       p1_velocity = v;
     }
     // Candidates made for other end points serve while no point is more than half the
-    // thickness from where they were made for (their boxes are grown by twice the thickness).
-    double off = 0.0;
-    for (Eigen::Index i = 0; i < p1.rows(); ++i) off = std::max(off, (p1.row(i) - potential_guess.row(i)).norm());
-    if (off > serve_radius() || largest_move(p0, built_p0) > serve_radius()) {
+    // thickness from the path they were made for (their boxes are grown by twice the thickness).
+    if (!candidates_serve(p1, nullptr, o1, nullptr)) {
       ContactReport scratch;
       make_potential_candidates(scratch);
     }
@@ -1968,14 +1979,11 @@ struct ContactStage::Impl {
     const Eigen::MatrixX3d pa = at_linearisation ? lin_points : end_points_of(from), pb = end_points_of(to);
     bound_to_velocity = to;
     bound_to_points = pb;
-    const double half = serve_radius();
-    // Candidates for the move pa → pb: the potential's where both ends stay within half the
-    // thickness of the end they were made for (the move in between does too), else a broad phase
+    // Candidates for the move pa → pb: the potential's where they serve it, else a broad phase
     // over this move.
     const std::vector<Candidate>* cands = &potential_cands;
     std::vector<Candidate> own;
-    if (!(largest_move(pa, potential_guess) <= half && largest_move(pb, potential_guess) <= half &&
-          largest_move(p0, built_p0) <= half)) {
+    if (!candidates_serve(pa, &pb, o1, nullptr)) {
       const Eigen::MatrixX3d start_points = p0, end_points = p1;
       const bool boxes = obstacle_boxes_current;
       p0 = pa;
