@@ -442,9 +442,34 @@ struct ContactStage::Impl {
   void update_end_points(const Eigen::VectorXd& v) {
     if (end_points_current) return;
     end_points_current = true;
+    p1 = end_points_of(v);
+  }
+
+  // The end points p0 + h J v (#P × 3) for velocities v. With the points' rows in node form
+  // (potential mode) one pass over each point's nodes gives all three components (the same sums,
+  // in the same order, as J's three rows).
+  Eigen::MatrixX3d end_points_of(const Eigen::VectorXd& v) const {
+    Eigen::MatrixX3d out(p0.rows(), 3);
+    if (point_rows_in_node_form) {
+      tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p0.rows(), 2048), [&](const tbb::blocked_range<Eigen::Index>& range) {
+        for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
+          double x = 0.0, y = 0.0, z = 0.0;
+          for (const auto& [node, w] : point_rows[static_cast<size_t>(p)].nodes) {
+            const double* vn = v.data() + 3 * static_cast<Eigen::Index>(node);
+            x += w * vn[0];
+            y += w * vn[1];
+            z += w * vn[2];
+          }
+          out(p, 0) = p0(p, 0) + h * x;
+          out(p, 1) = p0(p, 1) + h * y;
+          out(p, 2) = p0(p, 2) + h * z;
+        }
+      });
+      return out;
+    }
     Eigen::VectorXd pv(jacobian.rows());  // surface point velocities, flat
     parallel_product(jacobian, v.data(), v.size(), 1, pv.data());
-    p1 = p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
+    return p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
   }
 
   // --- Broad phase -----------------------------------------------------------------------------
@@ -1589,14 +1614,18 @@ struct ContactStage::Impl {
     return std::sqrt(worst);
   }
   // Whether the candidates serve surface points p (and, when not null, q: any move between the
-  // two) with the obstacle vertices o (and, when not null, any move from `o_from` to them).
-  bool candidates_serve(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d* q, const Eigen::MatrixX3d& o,
-                        const Eigen::MatrixX3d* o_from) const {
+  // two) with the obstacles anywhere over this step (obstacles_serve, checked once per step).
+  bool obstacles_serve = false;
+  bool candidates_serve(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d* q) const {
     const double r = serve_radius();
-    return sweep_distance(p, built_p0, potential_guess) <= r && (q == nullptr || sweep_distance(*q, built_p0, potential_guess) <= r) &&
-           sweep_distance(o, built_o0, built_o1) <= r && (o_from == nullptr || sweep_distance(*o_from, built_o0, built_o1) <= r);
+    return obstacles_serve && sweep_distance(p, built_p0, potential_guess) <= r &&
+           (q == nullptr || sweep_distance(*q, built_p0, potential_guess) <= r);
   }
-  bool candidates_serve() const { return candidates_serve(p0, &p1, o0, &o1); }
+  bool candidates_serve() const { return candidates_serve(p0, &p1); }
+  void check_obstacles_serve() {
+    const double r = serve_radius();
+    obstacles_serve = sweep_distance(o0, built_o0, built_o1) <= r && sweep_distance(o1, built_o0, built_o1) <= r;
+  }
   void make_potential_candidates(ContactReport& report) {
     lin_bounds_valid = false;
     candidate_grow = settings.thickness + 2.0 * serve_radius();
@@ -1606,6 +1635,7 @@ struct ContactStage::Impl {
     built_p0 = p0;
     built_o0 = o0;
     built_o1 = o1;
+    obstacles_serve = true;
     prepare_candidates();
   }
   // Per step (and after a new broad phase): each candidate's distance bound and, where it may be
@@ -1813,6 +1843,7 @@ struct ContactStage::Impl {
     plane_stiffness.resize(static_cast<size_t>(p0.rows()));
     for (Eigen::Index p = 0; p < p0.rows(); ++p) plane_stiffness[static_cast<size_t>(p)] = barrier_ratio() * point_mass(p) / (h * h);
     ContactReport scratch;
+    check_obstacles_serve();
     if (candidates_serve()) {
       prepare_candidates();
     } else {
@@ -1893,7 +1924,7 @@ struct ContactStage::Impl {
     }
     // Candidates made for other end points serve while no point is more than half the
     // thickness from the path they were made for (their boxes are grown by twice the thickness).
-    if (!candidates_serve(p1, nullptr, o1, nullptr)) {
+    if (!candidates_serve(p1, nullptr)) {
       ContactReport scratch;
       make_potential_candidates(scratch);
     }
@@ -1968,11 +1999,6 @@ struct ContactStage::Impl {
   }
 
   // The end points p0 + h J v (#P × 3) for velocities v.
-  Eigen::MatrixX3d end_points_of(const Eigen::VectorXd& v) const {
-    Eigen::VectorXd pv(jacobian.rows());
-    parallel_product(jacobian, v.data(), v.size(), 1, pv.data());
-    return p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
-  }
 
   double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
     const bool at_linearisation = lin_bounds_valid && from.size() == lin_velocity.size() && from == lin_velocity;
@@ -1983,7 +2009,7 @@ struct ContactStage::Impl {
     // over this move.
     const std::vector<Candidate>* cands = &potential_cands;
     std::vector<Candidate> own;
-    if (!candidates_serve(pa, &pb, o1, nullptr)) {
+    if (!candidates_serve(pa, &pb)) {
       const Eigen::MatrixX3d start_points = p0, end_points = p1;
       const bool boxes = obstacle_boxes_current;
       p0 = pa;
@@ -2016,6 +2042,7 @@ struct ContactStage::Impl {
     // separation by more than its points move (to either end of the move) is skipped.
     double obstacle_motion = 0.0, motion = 0.0;
     const Bounds* bounds = cands == &potential_cands ? &reference_bounds(pa, &pb, false, obstacle_motion, motion) : nullptr;
+    const Eigen::VectorXd step_move = (pb - pa).rowwise().norm();  // per point, over the move
     const std::vector<double>* lower = bounds != nullptr ? &bounds->lower : nullptr;
     std::vector<double> bound(cands->size(), 1.0);
     auto visit = [&](size_t i) {
@@ -2044,6 +2071,9 @@ struct ContactStage::Impl {
         const double start_distance = geometry(c, a).distance;
         if (!(start_distance > 0)) return;  // (touching already: nothing to bound)
         separation = std::min(separation, 0.5 * start_distance);
+        // (A pair that does not move enough to lose what it has above the separation: most pairs
+        // resting in contact between two Newton iterates.)
+        if (start_distance - pair_motion(c, step_move, 0.0) > separation) return;
         const contact::CcdResult r = pt ? contact::point_triangle_ccd(a, b, separation) : contact::edge_edge_ccd(a, b, separation);
         if (r.hit) bound[i] = r.toi;
     };
@@ -2118,6 +2148,7 @@ struct ContactStage::Impl {
       end_points_current = v.size() == p1_velocity.size() && v == p1_velocity;
     } else {
       start_positions(x, t);
+      if (potential_on) check_obstacles_serve();
     }
     update_end_points(v);
     report.narrow_ms += ms_since(t0);
