@@ -13,7 +13,9 @@ namespace {
 
 constexpr std::string_view kMagic = "clothsim checkpoint\n";
 constexpr std::string_view kEnd = "end\n";
-constexpr std::uint32_t kVersion = 3;  // 2: RunTotals::contact_response_factorizations; 3: the coupled pattern
+// 2: RunTotals::contact_response_factorizations; 3: the coupled pattern; 4: RunTotals::contact as
+// ContactCounters.
+constexpr std::uint32_t kVersion = 4;
 
 class Writer {
  public:

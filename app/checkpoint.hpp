@@ -8,6 +8,7 @@
 // machine; anything else is refused with a message.
 #pragma once
 
+#include "sim/core/contact_counters.hpp"
 #include "sim/dynamics/simulator.hpp"
 
 #include <cstdint>
@@ -23,11 +24,7 @@ struct RunTotals {
   double rotate_ms = 0.0, assemble_ms = 0.0, solve_ms = 0.0;
   int frames = 0;
   int max_solver_iterations = 0;
-  long long contact_pairs = 0, contact_impulses = 0, impact_zones = 0, contact_unresolved = 0;
-  long long contact_response_iterations = 0, contact_cg_iterations = 0, contact_response_factorizations = 0;
-  double contact_ms = 0.0, contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;
-  long long contact_newton_iterations = 0;  // linear solves of steps with the contact barrier
-  double contact_potential_ms = 0.0;        // evaluating the barrier (part of contact_ms)
+  ContactCounters contact;
 };
 
 struct RunCheckpoint {

@@ -192,20 +192,20 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                    {"warnings", warnings},
                    {"status", status}};
   if (scene.problem.has_contact())
-    j["contact"] = {{"pairs_tested", totals.contact_pairs},
-                    {"impulses", totals.contact_impulses},
-                    {"impact_zones", totals.impact_zones},
-                    {"unresolved_pairs", totals.contact_unresolved},
-                    {"seconds", totals.contact_ms / 1000.0},
-                    {"broad_phase_seconds", totals.contact_broad_ms / 1000.0},
-                    {"narrow_phase_seconds", totals.contact_narrow_ms / 1000.0},
-                    {"response_seconds", totals.contact_response_ms / 1000.0},
-                    {"response_iterations", totals.contact_response_iterations},
-                    {"response_cg_iterations", totals.contact_cg_iterations},
-                    {"response_factorizations", totals.contact_response_factorizations},
+    j["contact"] = {{"pairs_tested", totals.contact.pairs_tested},
+                    {"impulses", totals.contact.impulses},
+                    {"impact_zones", totals.contact.impact_zones},
+                    {"unresolved_pairs", totals.contact.unresolved},
+                    {"seconds", totals.contact.ms / 1000.0},
+                    {"broad_phase_seconds", totals.contact.broad_ms / 1000.0},
+                    {"narrow_phase_seconds", totals.contact.narrow_ms / 1000.0},
+                    {"response_seconds", totals.contact.response_ms / 1000.0},
+                    {"response_iterations", totals.contact.response_iterations},
+                    {"response_cg_iterations", totals.contact.response_cg_iterations},
+                    {"response_factorizations", totals.contact.response_factorizations},
                     {"method", scene.problem.collision.barrier ? "barrier" : "constraints"},
-                    {"barrier_seconds", totals.contact_potential_ms / 1000.0},
-                    {"newton_iterations", totals.contact_newton_iterations}};
+                    {"barrier_seconds", totals.contact.potential_ms / 1000.0},
+                    {"newton_iterations", totals.contact.newton_iterations}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -323,12 +323,11 @@ class Outputs {
           format_double(s.boundary_work), std::to_string(s.factorizations), format_double(s.factor_ms)})
       row.append(1, ',').append(field);
     if (scene_.problem.has_contact())
-      for (const std::string& field : {std::to_string(s.contact_pairs), std::to_string(s.contact_impulses),
-                                       std::to_string(s.impact_zones), std::to_string(s.contact_unresolved),
-                                       format_double(s.contact_ms), std::to_string(s.contact_response_iterations),
-                                       std::to_string(s.contact_cg_iterations), std::to_string(s.contact_response_factorizations),
-                                       std::to_string(s.contact_newton_iterations), std::to_string(s.contact_active_pairs),
-                                       format_double(s.contact_energy)})
+      for (const std::string& field :
+           {std::to_string(s.contact.pairs_tested), std::to_string(s.contact.impulses), std::to_string(s.contact.impact_zones),
+            std::to_string(s.contact.unresolved), format_double(s.contact.ms), std::to_string(s.contact.response_iterations),
+            std::to_string(s.contact.response_cg_iterations), std::to_string(s.contact.response_factorizations),
+            std::to_string(s.contact.newton_iterations), std::to_string(s.contact_active_pairs), format_double(s.contact_energy)})
         row.append(1, ',').append(field);
     stats_.line(row);  // flushed by record_state, together with the probes
   }
@@ -654,27 +653,15 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
           totals.assemble_ms += s.assemble_ms;
           totals.solve_ms += s.solve_ms;
           totals.max_solver_iterations = std::max(totals.max_solver_iterations, s.solver_iterations);
-          totals.contact_pairs += s.contact_pairs;
-          totals.contact_impulses += s.contact_impulses;
-          totals.impact_zones += s.impact_zones;
-          totals.contact_unresolved += s.contact_unresolved;
-          if (s.contact_unresolved > 0) {
+          totals.contact += s.contact;
+          if (s.contact.unresolved > 0) {
             // The fail-safe gave up on these pairs: the surfaces may cross from this step on.
             unresolved_steps.push_back(s.step);
             log_line("warning: step " + std::to_string(s.step) + " (t = " + format_short(s.t) + " s): " +
-                     std::to_string(s.contact_unresolved) +
+                     std::to_string(s.contact.unresolved) +
                      " contact pair(s) still colliding at the end of the step; frames from this time on may show "
                      "crossing surfaces (stats.csv: contact_unresolved)");
           }
-          totals.contact_ms += s.contact_ms;
-          totals.contact_broad_ms += s.contact_broad_ms;
-          totals.contact_narrow_ms += s.contact_narrow_ms;
-          totals.contact_response_ms += s.contact_response_ms;
-          totals.contact_response_iterations += s.contact_response_iterations;
-          totals.contact_cg_iterations += s.contact_cg_iterations;
-          totals.contact_response_factorizations += s.contact_response_factorizations;
-          totals.contact_newton_iterations += s.contact_newton_iterations;
-          totals.contact_potential_ms += s.contact_potential_ms;
           const int frames_before = totals.frames;
           outputs->record_stats(s);
           outputs->record_state(*sim, s.step, s.t, totals);

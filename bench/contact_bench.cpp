@@ -42,10 +42,10 @@ void contact_scene(benchmark::State& state, const Case& c, bool barrier) {
       state.ResumeTiming();
     }
     const StepStats s = sim->step();
-    contact += s.contact_ms;
+    contact += s.contact.ms;
     rest += s.rotate_ms + s.assemble_ms + s.solve_ms;
-    newton += s.contact_newton_iterations;
-    impulses += s.contact_impulses;
+    newton += static_cast<double>(s.contact.newton_iterations);
+    impulses += static_cast<double>(s.contact.impulses);
     ++steps;
   }
   state.counters["contact_ms"] = contact / steps;

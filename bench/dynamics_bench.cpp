@@ -65,10 +65,10 @@ void BM_SleeveCompress2542Step(benchmark::State& state) {
     iterations += s.solver_iterations;
     factor += s.factor_ms;
     factorizations += s.factorizations;
-    contact += s.contact_ms;
-    broad += s.contact_broad_ms;
-    narrow += s.contact_narrow_ms;
-    response += s.contact_response_ms;
+    contact += s.contact.ms;
+    broad += s.contact.broad_ms;
+    narrow += s.contact.narrow_ms;
+    response += s.contact.response_ms;
     ++steps;
   }
   state.counters["rotate_ms"] = rotate / steps;

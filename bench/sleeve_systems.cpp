@@ -14,7 +14,7 @@
 // Prints one line per step (iterations, factorisations, solve time, residual check).
 #include "bench/system_io.hpp"
 #include "sim/dynamics/simulator.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 #include "sim/scene/scene.hpp"
 
 #include <algorithm>

@@ -1,14 +1,16 @@
 #include "sim/contact/contact_stage.hpp"
 
 #include "sim/contact/barrier.hpp"
+#include "sim/contact/impact_zones.hpp"
 #include "sim/contact/narrow_phase.hpp"
+#include "sim/contact/obstacle_set.hpp"
+#include "sim/contact/pair_types.hpp"
 #include "sim/solver/cholesky_preconditioner.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include <algorithm>
 #include <atomic>
@@ -19,7 +21,6 @@
 #include <functional>
 #include <limits>
 #include <map>
-#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -31,6 +32,14 @@ using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 using contact::Box;
+using contact::Bounds;
+using contact::Candidate;
+using contact::Constraint;
+using contact::fit_rigid;
+using contact::Kind;
+using contact::PairGeometry;
+using contact::RigidMap;
+using contact::Zones;
 using RowPoints = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 // y = A X for a row-major sparse A and a dense X with `cols` columns (column-major, X.rows() =
@@ -52,121 +61,6 @@ void parallel_product(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, con
   });
 }
 
-// A narrow-phase pair. Points and triangles index the collision surface ("cloth") or the
-// obstacles' combined mesh ("obstacle"); edges likewise.
-enum class Kind : std::uint8_t {
-  cloth_point_cloth_triangle,
-  cloth_edge_cloth_edge,
-  cloth_point_obstacle_triangle,
-  obstacle_point_cloth_triangle,
-  cloth_edge_obstacle_edge,
-};
-
-struct Candidate {
-  Kind kind;
-  int a, b;  // point and triangle, or edge and edge, in the order of the kind's name
-  bool near = false;  // from triangles near each other at rest: CCD only, at a tiny separation
-  bool operator<(const Candidate& o) const {
-    return std::tie(kind, a, b) < std::tie(o.kind, o.a, o.b);
-  }
-  bool operator==(const Candidate& o) const { return kind == o.kind && a == o.a && b == o.b; }
-};
-
-// Lower bounds of the distances of a list of candidate pairs at some configuration
-// (ContactStage::Impl::reference_bounds), and those below a reach.
-struct Bounds {
-  std::vector<double> lower;    // per candidate [m]
-  std::vector<size_t> close;    // the candidates whose bound is below `reach`
-  double reach = 0.0;           // [m]
-  void make_close(double r) {
-    reach = r;
-    close.clear();
-    for (size_t i = 0; i < lower.size(); ++i)
-      if (lower[i] < r) close.push_back(i);
-  }
-  // The bounds less `motion` (at least 0): the bounds after every point moved by at most that.
-  std::vector<double> less(double motion) const {
-    std::vector<double> out(lower.size());
-    for (size_t i = 0; i < lower.size(); ++i) out[i] = std::max(0.0, lower[i] - motion);
-    return out;
-  }
-};
-
-// Geometry of one pair at one instant: up to four points on each side with coefficients
-// (relative position = Σ c_k p_k, cloth points first), a unit normal from the second primitive
-// to the first, and their distance.
-struct PairGeometry {
-  int num = 0;                        // points in use
-  std::array<int, 4> point{};         // point index (cloth or obstacle, see `obstacle`)
-  std::array<bool, 4> obstacle{};     // whether the point is an obstacle vertex
-  std::array<double, 4> coef{};       // +1 / weights on the first primitive, −weights on the second
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
-  double distance = 0.0;
-};
-
-// A contact constraint in DOF space: the relative velocity of the pair is
-// u = Σ_dof B[dof] v[dof] + u_obstacle (3-vectors B), so an impulse λ along a unit direction e
-// changes v[dof] by W[dof] λ (B[dof]·e).
-struct Constraint {
-  std::vector<std::pair<int, Eigen::Vector3d>> b;  // (dof, B[dof])
-  Eigen::Vector3d obstacle_velocity = Eigen::Vector3d::Zero();
-  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
-  double target = 0.0;    // wanted normal relative velocity [m/s]
-  double mu = 0.0;        // friction coefficient
-  double lambda = 0.0;    // accumulated normal impulse [N·s]
-  Eigen::Vector3d friction = Eigen::Vector3d::Zero();  // accumulated tangential impulse [N·s]
-  int obstacle = -1;      // obstacle involved, or −1
-};
-
-// Union–find over nodes for impact zones.
-struct Zones {
-  std::vector<int> parent;
-  explicit Zones(int n) : parent(static_cast<size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int i) {
-    while (parent[static_cast<size_t>(i)] != i) {
-      parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
-      i = parent[static_cast<size_t>(i)];
-    }
-    return i;
-  }
-  void unite(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[static_cast<size_t>(std::max(a, b))] = std::min(a, b);
-  }
-};
-
-// A rigid map p ↦ R p + c.
-struct RigidMap {
-  Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  Eigen::Vector3d operator()(const Eigen::Vector3d& p) const { return r * p + c; }
-};
-
-// The rigid map that best takes points `from` to `to` (Kabsch, equal weights); a translation
-// for fewer than three points.
-RigidMap fit_rigid(const std::vector<Eigen::Vector3d>& from, const std::vector<Eigen::Vector3d>& to) {
-  RigidMap m;
-  if (from.empty()) return m;
-  Eigen::Vector3d cf = Eigen::Vector3d::Zero(), ct = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < from.size(); ++i) {
-    cf += from[i];
-    ct += to[i];
-  }
-  cf /= static_cast<double>(from.size());
-  ct /= static_cast<double>(from.size());
-  if (from.size() >= 3) {
-    Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
-    for (size_t i = 0; i < from.size(); ++i) h += (from[i] - cf) * (to[i] - ct).transpose();
-    Eigen::JacobiSVD<Eigen::Matrix3d> svd(h, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d d = Eigen::Matrix3d::Identity();
-    d(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1.0 : 1.0;
-    m.r = svd.matrixV() * d * svd.matrixU().transpose();
-  }
-  m.c = ct - m.r * cf;
-  return m;
-}
-
 }  // namespace
 
 struct ContactStage::Impl {
@@ -185,19 +79,7 @@ struct ContactStage::Impl {
   std::vector<char> free;
   Eigen::VectorXd node_mass;
 
-  // The obstacles' meshes, combined (planes are apart).
-  std::vector<Triangle> obstacle_triangles;
-  std::vector<std::array<int, 2>> obstacle_edges;
-  std::vector<char> obstacle_edge_flat, obstacle_vertex_flat;  // between coplanar triangles; all edges flat
-  // tan(θ / 2) of the angle θ between the normals of an edge's two triangles (infinite for an edge
-  // with one or more than two), and per vertex the largest of its edges': see
-  // measure_smooth_tangents().
-  std::vector<double> obstacle_edge_tangent, obstacle_vertex_tangent;
-  std::vector<std::array<int, 3>> obstacle_triangle_edges;
-  std::vector<std::vector<int>> obstacle_owned_points, obstacle_owned_edges;
-  std::vector<int> obstacle_of_vertex;  // obstacle index per combined vertex
-  std::vector<int> vertex_offset;       // per obstacle: first combined vertex
-  std::vector<int> planes;              // obstacle indices of planes
+  contact::ObstacleSet obs;  // the obstacles' meshes, combined (planes apart)
 
   contact::BroadPhase self_broad, obstacle_broad;
   // Patches: the fine triangles over one surface triangle of the discretisation (display
@@ -234,8 +116,8 @@ struct ContactStage::Impl {
   double h = 0.0;
 
   Impl(const Discretization& disc, const Eigen::VectorXd& mass, const std::vector<char>& free_dofs,
-       const CollisionSettings& s, std::vector<Obstacle> obs, const ContactParameters& p)
-      : d(disc), settings(s), params(p), obstacles(std::move(obs)), free(free_dofs), node_mass(mass) {
+       const CollisionSettings& s, std::vector<Obstacle> obstacle_list, const ContactParameters& p)
+      : d(disc), settings(s), params(p), obstacles(std::move(obstacle_list)), free(free_dofs), node_mass(mass) {
     if (!(settings.thickness > 0)) throw std::invalid_argument("collision: the thickness must be > 0 [m]");
     if (!(settings.friction >= 0)) throw std::invalid_argument("collision: the friction coefficient must be >= 0");
     if (!(settings.tolerance > 0 && settings.tolerance <= 0.1))
@@ -250,8 +132,8 @@ struct ContactStage::Impl {
     if (static_cast<int>(free.size()) != n3 || node_mass.size() != d.num_nodes())
       throw std::invalid_argument("ContactStage: the masses and the free-DOF mask must cover every node");
     slot.assign(static_cast<size_t>(n3), -1);
-    build_edges(surface.triangles, edges, triangle_edges);
-    build_ownership(surface.triangles, static_cast<int>(rest_points.rows()), triangle_edges, static_cast<int>(edges.size()),
+    contact::build_edges(surface.triangles, edges, triangle_edges);
+    contact::build_ownership(surface.triangles, static_cast<int>(rest_points.rows()), triangle_edges, static_cast<int>(edges.size()),
                     owned_points, owned_edges);
     fine_per_patch = 1 << (2 * surface.levels);
     num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
@@ -280,67 +162,13 @@ struct ContactStage::Impl {
       pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
     }
 
-    std::vector<Triangle> tris;
-    for (size_t k = 0; k < obstacles.size(); ++k) {
-      const Obstacle& o = obstacles[k];
-      vertex_offset.push_back(static_cast<int>(obstacle_of_vertex.size()));
-      if (o.shape == Obstacle::Shape::plane) {
-        planes.push_back(static_cast<int>(k));
-        continue;
-      }
-      if (o.mesh.num_triangles() == 0) {
-        if (o.shape == Obstacle::Shape::mesh)
-          throw std::invalid_argument("obstacle " + o.name + ": a mesh obstacle needs triangles");
-        obstacles[k].mesh = tessellate(o);  // a primitive built in code without its tessellation
-      }
-      const int offset = vertex_offset.back();
-      for (int v = 0; v < o.mesh.num_vertices(); ++v) obstacle_of_vertex.push_back(static_cast<int>(k));
-      for (const Triangle& t : o.mesh.triangles) obstacle_triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-    }
-    build_edges(obstacle_triangles, obstacle_edges, obstacle_triangle_edges);
-    build_ownership(obstacle_triangles, static_cast<int>(obstacle_of_vertex.size()), obstacle_triangle_edges,
-                    static_cast<int>(obstacle_edges.size()), obstacle_owned_points, obstacle_owned_edges);
-    drop_flat_obstacle_edges();
+    obs = contact::ObstacleSet(obstacles);
   }
 
-  // An obstacle edge between two coplanar triangles (inside a flat face: a box side, a cylinder's
-  // cap) makes no pair of its own. The obstacle is rigid, so the face stays flat; a segment's
-  // distance to a flat region is attained at one of its end points (point–triangle pairs) or on
-  // the region's boundary (its other edges), and so is its first contact when it moves (where it
-  // touches the region's inside at an inner point, it lies in the plane and crosses the boundary
-  // too). On the Cusick support's cap these edges made two thirds of the constraints.
-  void drop_flat_obstacle_edges() {
-    std::vector<std::vector<int>> edge_triangles(obstacle_edges.size());
-    for (size_t t = 0; t < obstacle_triangle_edges.size(); ++t)
-      for (int e : obstacle_triangle_edges[t]) edge_triangles[static_cast<size_t>(e)].push_back(static_cast<int>(t));
-    Eigen::MatrixX3d rest(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
-    for (size_t k = 0; k < obstacles.size(); ++k)
-      if (obstacles[k].shape != Obstacle::Shape::plane)
-        rest.middleRows(vertex_offset[k], obstacles[k].mesh.num_vertices()) = obstacles[k].mesh.vertices;
-    auto normal = [&](int t) {
-      const Triangle& tri = obstacle_triangles[static_cast<size_t>(t)];
-      const Eigen::Vector3d a = rest.row(tri[0]), b = rest.row(tri[1]), c = rest.row(tri[2]);
-      return Eigen::Vector3d((b - a).cross(c - a));
-    };
-    std::vector<char> flat(obstacle_edges.size(), 0);
-    obstacle_edge_tangent.assign(obstacle_edges.size(), std::numeric_limits<double>::infinity());
-    obstacle_vertex_tangent.assign(obstacle_of_vertex.size(), 0.0);
-    for (size_t e = 0; e < obstacle_edges.size(); ++e) {
-      if (edge_triangles[e].size() == 2) {
-        const Eigen::Vector3d n1 = normal(edge_triangles[e][0]), n2 = normal(edge_triangles[e][1]);
-        flat[e] = n1.dot(n2) > 0 && n1.cross(n2).norm() <= 1e-12 * n1.norm() * n2.norm();
-        obstacle_edge_tangent[e] = std::tan(0.5 * std::atan2(n1.cross(n2).norm(), n1.dot(n2)));
-      }
-      for (int v : obstacle_edges[e])
-        obstacle_vertex_tangent[static_cast<size_t>(v)] = std::max(obstacle_vertex_tangent[static_cast<size_t>(v)], obstacle_edge_tangent[e]);
-    }
-    for (std::vector<int>& owned : obstacle_owned_edges)
-      owned.erase(std::remove_if(owned.begin(), owned.end(), [&](int e) { return flat[static_cast<size_t>(e)] != 0; }), owned.end());
-    obstacle_edge_flat = flat;
-    obstacle_vertex_flat.assign(obstacle_of_vertex.size(), 1);
-    for (size_t e = 0; e < obstacle_edges.size(); ++e)
-      if (!flat[e])
-        for (int v : obstacle_edges[e]) obstacle_vertex_flat[static_cast<size_t>(v)] = 0;
+  // A point–obstacle-triangle pair that adds nothing (contact::ObstacleSet::redundant_on_flat_face).
+  bool redundant_on_flat_face_pair(const Candidate& c, const PairGeometry& g, const std::array<Eigen::Vector3d, 4>& x) const {
+    return c.kind == Kind::cloth_point_obstacle_triangle &&
+           obs.redundant_on_flat_face(c.b, {-g.coef[1], -g.coef[2], -g.coef[3]}, g.normal, x[1], x[2], x[3]);
   }
 
   // Obstacle edges and vertices that bend the obstacle's surface little make no pairs with a
@@ -373,65 +201,6 @@ struct ContactStage::Impl {
     for (size_t i = 0; i < surface.triangles.size(); ++i)
       for (int e : triangle_edges[i])
         smooth_tangent_edge[static_cast<size_t>(e)] = std::min(smooth_tangent_edge[static_cast<size_t>(e)], smooth_tangent_triangle[i]);
-  }
-
-  // A point–obstacle-triangle pair adds nothing when the point's closest point on the triangle
-  // lies on a flat edge, or on a vertex inside a flat face, while the point is not over the
-  // triangle: then it is over a coplanar neighbour (or beyond it), which is at least as close and
-  // makes its own pair; at a first contact, that neighbour is touched first or at the same time.
-  // (A point right over the shared edge or vertex keeps every pair: all give the same constraint.)
-  bool redundant_on_flat_face(const Candidate& c, const PairGeometry& g, const std::array<Eigen::Vector3d, 4>& x) const {
-    if (c.kind != Kind::cloth_point_obstacle_triangle) return false;
-    const Eigen::Vector3d n = (x[2] - x[1]).cross(x[3] - x[1]);
-    if (g.normal.cross(n).norm() <= 1e-9 * n.norm()) return false;
-    const auto& tri = obstacle_triangles[static_cast<size_t>(c.b)];
-    const auto& tri_edges = obstacle_triangle_edges[static_cast<size_t>(c.b)];
-    int zeros = 0, zero = -1, nonzero = -1;
-    for (int k = 0; k < 3; ++k) {
-      if (-g.coef[static_cast<size_t>(k + 1)] <= 0.0) {
-        ++zeros;
-        zero = k;
-      } else {
-        nonzero = k;
-      }
-    }
-    if (zeros == 1) return obstacle_edge_flat[static_cast<size_t>(tri_edges[static_cast<size_t>((zero + 1) % 3)])] != 0;
-    if (zeros == 2) return obstacle_vertex_flat[static_cast<size_t>(tri[static_cast<size_t>(nonzero)])] != 0;
-    return false;
-  }
-
-  // Each point and each edge is owned by the first triangle that has it, so that expanding
-  // triangle pairs into point–triangle and edge–edge pairs makes each pair once.
-  static void build_ownership(const std::vector<Triangle>& tris, int num_points, const std::vector<std::array<int, 3>>& tri_edges,
-                              int num_edges, std::vector<std::vector<int>>& points, std::vector<std::vector<int>>& owned_edges) {
-    std::vector<char> point_taken(static_cast<size_t>(num_points), 0), edge_taken(static_cast<size_t>(num_edges), 0);
-    points.assign(tris.size(), {});
-    owned_edges.assign(tris.size(), {});
-    for (size_t t = 0; t < tris.size(); ++t)
-      for (int k = 0; k < 3; ++k) {
-        const int v = tris[t][static_cast<size_t>(k)], e = tri_edges[t][static_cast<size_t>(k)];
-        if (!point_taken[static_cast<size_t>(v)]) {
-          point_taken[static_cast<size_t>(v)] = 1;
-          points[t].push_back(v);
-        }
-        if (!edge_taken[static_cast<size_t>(e)]) {
-          edge_taken[static_cast<size_t>(e)] = 1;
-          owned_edges[t].push_back(e);
-        }
-      }
-  }
-
-  static void build_edges(const std::vector<Triangle>& tris, std::vector<std::array<int, 2>>& out,
-                          std::vector<std::array<int, 3>>& per_triangle) {
-    std::map<std::pair<int, int>, int> ids;
-    per_triangle.resize(tris.size());
-    for (size_t t = 0; t < tris.size(); ++t)
-      for (int k = 0; k < 3; ++k) {
-        const auto key = std::minmax(tris[t][static_cast<size_t>(k)], tris[t][static_cast<size_t>((k + 1) % 3)]);
-        auto [it, inserted] = ids.emplace(key, static_cast<int>(out.size()));
-        if (inserted) out.push_back({key.first, key.second});
-        per_triangle[t][static_cast<size_t>(k)] = it->second;
-      }
   }
 
   // --- Positions -------------------------------------------------------------------------------
@@ -808,19 +577,19 @@ struct ContactStage::Impl {
       });
       for (const std::vector<Candidate>& chunk : chunks) out.insert(out.end(), chunk.begin(), chunk.end());
     }
-    if (!obstacle_triangles.empty()) {
+    if (!obs.triangles.empty()) {
       if (!obstacle_boxes_current) {  // once per step: the obstacles' motion is known for the step
-        obstacle_boxes.resize(obstacle_triangles.size());
-        for (size_t t = 0; t < obstacle_triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obstacle_triangles[t], 0.0);
-        obstacle_point_box.resize(obstacle_of_vertex.size());
+        obstacle_boxes.resize(obs.triangles.size());
+        for (size_t t = 0; t < obs.triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obs.triangles[t], 0.0);
+        obstacle_point_box.resize(obs.obstacle_of_vertex.size());
         for (size_t v = 0; v < obstacle_point_box.size(); ++v) {
           const int i = static_cast<int>(v);
           obstacle_point_box[v] = swept_box(o0, o1, {i, i, i}, 0.0);
         }
-        obstacle_edge_box.resize(obstacle_edges.size());
-        for (size_t e = 0; e < obstacle_edges.size(); ++e) {
-          const Box& a = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][0])];
-          const Box& b = obstacle_point_box[static_cast<size_t>(obstacle_edges[e][1])];
+        obstacle_edge_box.resize(obs.edges.size());
+        for (size_t e = 0; e < obs.edges.size(); ++e) {
+          const Box& a = obstacle_point_box[static_cast<size_t>(obs.edges[e][0])];
+          const Box& b = obstacle_point_box[static_cast<size_t>(obs.edges[e][1])];
           obstacle_edge_box[e] = grown(Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}, 0.5 * grow);
         }
         obstacle_boxes_current = true;
@@ -832,13 +601,13 @@ struct ContactStage::Impl {
           for (int v : owned_points[static_cast<size_t>(i)])
             if (overlap(point_grown[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
               out.push_back({Kind::cloth_point_obstacle_triangle, v, j});
-          for (int v : obstacle_owned_points[static_cast<size_t>(j)])
-            if (obstacle_vertex_tangent[static_cast<size_t>(v)] > smooth_tangent_triangle[static_cast<size_t>(i)] &&
+          for (int v : obs.owned_points[static_cast<size_t>(j)])
+            if (obs.vertex_tangent[static_cast<size_t>(v)] > smooth_tangent_triangle[static_cast<size_t>(i)] &&
                 overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), triangle_box(i)))
               out.push_back({Kind::obstacle_point_cloth_triangle, v, i});
           for (int ea : owned_edges[static_cast<size_t>(i)])
-            for (int eb : obstacle_owned_edges[static_cast<size_t>(j)])
-              if (obstacle_edge_tangent[static_cast<size_t>(eb)] > smooth_tangent_edge[static_cast<size_t>(ea)] && overlap(edge_swept(ea), obstacle_edge_box[static_cast<size_t>(eb)]))
+            for (int eb : obs.owned_edges[static_cast<size_t>(j)])
+              if (obs.edge_tangent[static_cast<size_t>(eb)] > smooth_tangent_edge[static_cast<size_t>(ea)] && overlap(edge_swept(ea), obstacle_edge_box[static_cast<size_t>(eb)]))
                 out.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
         }
     }
@@ -866,7 +635,7 @@ struct ContactStage::Impl {
         return {cp(ea[0]), cp(ea[1]), cp(eb[0]), cp(eb[1])};
       }
       case Kind::cloth_point_obstacle_triangle: {
-        const auto& t = obstacle_triangles[static_cast<size_t>(c.b)];
+        const auto& t = obs.triangles[static_cast<size_t>(c.b)];
         return {cp(c.a), op(t[0]), op(t[1]), op(t[2])};
       }
       case Kind::obstacle_point_cloth_triangle: {
@@ -875,7 +644,7 @@ struct ContactStage::Impl {
       }
       case Kind::cloth_edge_obstacle_edge: {
         const auto& ea = edges[static_cast<size_t>(c.a)];
-        const auto& eb = obstacle_edges[static_cast<size_t>(c.b)];
+        const auto& eb = obs.edges[static_cast<size_t>(c.b)];
         return {cp(ea[0]), cp(ea[1]), op(eb[0]), op(eb[1])};
       }
     }
@@ -903,7 +672,7 @@ struct ContactStage::Impl {
         break;
       }
       case Kind::cloth_point_obstacle_triangle: {
-        const auto& t = obstacle_triangles[static_cast<size_t>(c.b)];
+        const auto& t = obs.triangles[static_cast<size_t>(c.b)];
         ids = {c.a, t[0], t[1], t[2]};
         obstacle = {false, true, true, true};
         break;
@@ -916,7 +685,7 @@ struct ContactStage::Impl {
       }
       case Kind::cloth_edge_obstacle_edge: {
         const auto& ea = edges[static_cast<size_t>(c.a)];
-        const auto& eb = obstacle_edges[static_cast<size_t>(c.b)];
+        const auto& eb = obs.edges[static_cast<size_t>(c.b)];
         ids = {ea[0], ea[1], eb[0], eb[1]};
         obstacle = {false, false, true, true};
         break;
@@ -940,7 +709,7 @@ struct ContactStage::Impl {
 
   int obstacle_of(const PairGeometry& g) const {
     for (int k = 0; k < g.num; ++k)
-      if (g.obstacle[static_cast<size_t>(k)]) return obstacle_of_vertex[static_cast<size_t>(g.point[static_cast<size_t>(k)])];
+      if (g.obstacle[static_cast<size_t>(k)]) return obs.obstacle_of_vertex[static_cast<size_t>(g.point[static_cast<size_t>(k)])];
     return -1;
   }
 
@@ -1029,7 +798,7 @@ struct ContactStage::Impl {
   // `end`, at its end: a plane that only translates has a distance linear in τ, so a point in
   // front at both ends is in front throughout).
   void plane_pairs(double t, bool end, double limit, std::vector<Found>& out, ContactReport& report) {
-    for (int k : planes) {
+    for (int k : obs.planes) {
       const Obstacle& o = obstacles[static_cast<size_t>(k)];
       Eigen::Vector3d q0, n0, q1, n1;
       plane_at(o, t, q0, n0);
@@ -1066,7 +835,7 @@ struct ContactStage::Impl {
         if (!cands[i].near) {  // neighbours in the material: only kept from crossing (collisions)
           const std::array<Eigen::Vector3d, 4> x = corners(cands[i], false);
           const PairGeometry g = geometry(cands[i], x);
-          close[i] = g.distance < settings.thickness && !redundant_on_flat_face(cands[i], g, x);
+          close[i] = g.distance < settings.thickness && !redundant_on_flat_face_pair(cands[i], g, x);
         }
     });
     for (size_t i = 0; i < cands.size(); ++i) {
@@ -1157,7 +926,7 @@ struct ContactStage::Impl {
       std::array<Eigen::Vector3d, 4> x;
       for (size_t k = 0; k < 4; ++k) x[k] = a[k] + toi[i] * (b[k] - a[k]);
       const PairGeometry g = geometry(c, x);
-      if (redundant_on_flat_face(c, g, x)) continue;
+      if (redundant_on_flat_face_pair(c, g, x)) continue;
       out.push_back({constraint(g), g.distance, separation, key_of(c, 1)});
       if (hit_pairs) hit_pairs->push_back(c);
     }
@@ -1676,7 +1445,7 @@ struct ContactStage::Impl {
       lower[i] = std::max(lower[i], gap);
       if (c.near || !(gap < settings.thickness)) return;
       lower[i] = start_geometry(i).distance;
-      cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face(c, cand_start[i], corner);
+      cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face_pair(c, cand_start[i], corner);
     };
     if (carried) {
       for_candidates(lin_bounds, motion, settings.thickness, visit);
@@ -1701,7 +1470,7 @@ struct ContactStage::Impl {
     for (size_t i = 0; i < potential_cands.size(); ++i) {
       const Candidate& c = potential_cands[i];
       if (!flagged[i] || c.kind != Kind::cloth_point_obstacle_triangle) continue;
-      const int obstacle = obstacle_of_vertex[static_cast<size_t>(obstacle_triangles[static_cast<size_t>(c.b)][0])];
+      const int obstacle = obs.obstacle_of_vertex[static_cast<size_t>(obs.triangles[static_cast<size_t>(c.b)][0])];
       auto [it, inserted] = closest.emplace(std::pair{c.a, obstacle}, i);
       if (inserted) continue;
       size_t& best = it->second;
@@ -1859,7 +1628,7 @@ struct ContactStage::Impl {
       const PairGeometry& g = cand_start[i];
       add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(g), -barrier.first(g.distance), [&] { return pair_row(g); });
     }
-    for (int k : planes) {
+    for (int k : obs.planes) {
       const Obstacle& o = obstacles[static_cast<size_t>(k)];
       Eigen::Vector3d q0, n0;
       plane_at(o, t, q0, n0);
@@ -1951,7 +1720,7 @@ struct ContactStage::Impl {
       if (c.near || gap > dhat) return;  // (most candidates: no exact distance)
       end[i] = geometry(c, corner);
       next.lower[i] = std::max(next.lower[i], end[i].distance);
-      if (redundant_on_flat_face(c, end[i], corner)) return;
+      if (redundant_on_flat_face_pair(c, end[i], corner)) return;
       if (end[i].distance < dhat) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
       active[i] = end[i].distance < dhat;
     });
@@ -1977,7 +1746,7 @@ struct ContactStage::Impl {
     keep_closest(active, end);
     for (size_t i = 0; i < potential_cands.size(); ++i)
       if (active[i]) add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]));
-    for (int k : planes) {
+    for (int k : obs.planes) {
       Eigen::Vector3d q1, n1;
       plane_at(obstacles[static_cast<size_t>(k)], t + h, q1, n1);
       for (Eigen::Index p = 0; p < p1.rows(); ++p) {
@@ -2086,7 +1855,7 @@ struct ContactStage::Impl {
     }
     double alpha = 1.0;
     for (double b : bound) alpha = std::min(alpha, b);
-    for (int k : planes) {
+    for (int k : obs.planes) {
       Eigen::Vector3d q1, n1;
       plane_at(obstacles[static_cast<size_t>(k)], potential_t + h, q1, n1);
       for (Eigen::Index p = 0; p < pa.rows(); ++p) {
@@ -2116,14 +1885,14 @@ struct ContactStage::Impl {
     parallel_product(surface.position, net.data(), net.rows(), 3, p0.data());
     end_points_current = false;
     obstacle_boxes_current = false;
-    if (!obstacle_of_vertex.empty()) {
-      o0.resize(static_cast<Eigen::Index>(obstacle_of_vertex.size()), 3);
+    if (!obs.obstacle_of_vertex.empty()) {
+      o0.resize(static_cast<Eigen::Index>(obs.obstacle_of_vertex.size()), 3);
       o1.resize(o0.rows(), 3);
       for (size_t k = 0; k < obstacles.size(); ++k) {
         const Obstacle& o = obstacles[k];
         if (o.shape == Obstacle::Shape::plane) continue;
-        o0.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t);
-        o1.middleRows(vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t + h);
+        o0.middleRows(obs.vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t);
+        o1.middleRows(obs.vertex_offset[k], o.mesh.num_vertices()) = mesh_at(o, t + h);
       }
     }
   }

@@ -31,8 +31,9 @@
 
 #include "sim/contact/broad_phase.hpp"
 #include "sim/contact/obstacle.hpp"
+#include "sim/core/contact_counters.hpp"
 #include "sim/discretization/discretization.hpp"
-#include "sim/integrator/step_potential.hpp"
+#include "sim/solver/step_potential.hpp"
 #include "sim/solver/pcg.hpp"
 
 #include <Eigen/Core>
@@ -43,18 +44,12 @@
 
 namespace clothsim {
 
-// What one step's contact stage did.
-struct ContactReport {
-  long long pairs_tested = 0;  // narrow-phase pairs (point–triangle and edge–edge) examined
+// What one step's contact stage did: the counters that add up over a run (pairs_tested,
+// impulses, impact_zones, unresolved, the response's iterations, the phases' times; its `ms` and
+// the potential's fields are left to the integrator), and two of its own.
+struct ContactReport : ContactCounters {
   int proximity_pairs = 0;     // pairs within the thickness at the start of the step
-  int impulses = 0;            // pairs given a normal impulse, plus friction impulses applied
-  int response_iterations = 0;     // augmented-Lagrangian iterations of the implicit response
-  long long response_cg_iterations = 0;  // conjugate-gradient iterations in them
-  int response_factorizations = 0;  // factorisations of the response's Newton matrix
   int ccd_collisions = 0;      // colliding pairs found by CCD, summed over the passes
-  int impact_zones = 0;        // zones the fail-safe made move as one (0 when not needed)
-  int unresolved = 0;          // pairs still colliding when the fail-safe gave up (should be 0)
-  double broad_ms = 0.0, narrow_ms = 0.0, response_ms = 0.0;  // split of the stage's time [ms]
   double total_ms() const { return broad_ms + narrow_ms + response_ms; }
 };
 
@@ -100,7 +95,7 @@ class ContactStage {
   // velocities [m/s] (the solution of `system`), changed in place on free components only.
   ContactReport filter(const Eigen::VectorXd& x, double t, double h, Eigen::VectorXd& v, const ResponseSystem& system);
 
-  // Contact inside the implicit step (sim/integrator/step_potential.hpp): after
+  // Contact inside the implicit step (sim/solver/step_potential.hpp): after
   // enable_potential(), proximity is a barrier energy of the end positions with lagged friction,
   // which the integrator minimises with the elastic model (begin_step / linearise / end_step), and
   // filter() is the fail-safe only: continuous collision detection with the implicit response

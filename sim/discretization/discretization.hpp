@@ -21,7 +21,7 @@
 
 #include "sim/core/layout.hpp"
 #include "sim/discretization/drawn_surface.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 #include "sim/mesh/mesh.hpp"
 
 #include <Eigen/Core>

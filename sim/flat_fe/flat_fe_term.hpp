@@ -32,7 +32,7 @@
 #pragma once
 
 #include "sim/flat_fe/dihedral.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 #include <Eigen/Core>
 

@@ -17,7 +17,7 @@
 // [J], matrix [N/m].
 #pragma once
 
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 #include <Eigen/Core>
 

@@ -8,7 +8,7 @@
 #pragma once
 
 #include "sim/corotation/corotational_elements.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 namespace clothsim {
 

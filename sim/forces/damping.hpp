@@ -10,7 +10,7 @@
 #pragma once
 
 #include "sim/core/sparse_pattern.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 #include <memory>
 #include <vector>

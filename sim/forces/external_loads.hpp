@@ -5,7 +5,7 @@
 // members are summed once, at construction.
 #pragma once
 
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 #include <memory>
 #include <vector>

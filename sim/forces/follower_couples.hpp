@@ -6,7 +6,7 @@
 // term is integrated explicitly (no energy, no matrix).
 #pragma once
 
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 #include <Eigen/Core>
 

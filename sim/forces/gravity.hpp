@@ -9,7 +9,7 @@
 #pragma once
 
 #include "sim/discretization/discretization.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 namespace clothsim {
 

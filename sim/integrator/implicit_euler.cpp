@@ -225,12 +225,12 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
   report.energy = lin.energy;
   potential_->end_step(v, report);
   potential_ms += ms_since(t0);
-  stats.contact_newton_iterations += report.newton_iterations;
+  stats.contact.newton_iterations += report.newton_iterations;
   stats.contact_active_pairs = report.active_pairs;
   stats.contact_friction_pairs = report.friction_pairs;
   stats.contact_energy = report.energy;
-  stats.contact_potential_ms += potential_ms;
-  stats.contact_ms += potential_ms;
+  stats.contact.potential_ms += potential_ms;
+  stats.contact.ms += potential_ms;
   stats.solve_ms -= potential_ms;  // (the caller times the whole call as the solve)
   return total;
 }
@@ -366,7 +366,7 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     } catch (const std::exception& e) {
       throw SimulationError(step_number, t_next, e.what());
     }
-    stats.contact_ms += ms_since(t0);
+    stats.contact.ms += ms_since(t0);
   }
 
   // Advance; scripted components land exactly on their motion, tied ones follow their rule.

@@ -1,5 +1,5 @@
 // Implicit Euler with the velocities as unknowns (paper §4.2 eq. 28 as a first-order system),
-// over any discretisation and any set of force terms (sim/forces/force_term.hpp).
+// over any discretisation and any set of force terms (sim/core/force_term.hpp).
 //
 // Each step solves the linearised
 //     (M + h D + h² K) v⁺ = M v + h f₀(x),     x⁺ = x + h v⁺,
@@ -22,9 +22,10 @@
 #pragma once
 
 #include "sim/integrator/scripted_boundary.hpp"
-#include "sim/integrator/step_potential.hpp"
+#include "sim/core/contact_counters.hpp"
+#include "sim/solver/step_potential.hpp"
 #include "sim/discretization/discretization.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 #include "sim/solver/linear_solver.hpp"
 
 #include <Eigen/Core>
@@ -74,22 +75,13 @@ struct StepStats {
   double external_work = 0.0;    // work of the external loads on the free components this step [J]
   double boundary_work = 0.0;    // work of the scripted and held components on the cloth this step
                                  // [J] (ImplicitEuler::boundary_work)
-  // The velocity filter's figures (contact, sim/contact/contact_stage.hpp; zero without one).
-  long long contact_pairs = 0;   // narrow-phase pairs tested
-  int contact_impulses = 0;      // impulses applied
-  int impact_zones = 0;          // zones the fail-safe moved as one
-  int contact_unresolved = 0;    // pairs still colliding at the end of the step (should be 0)
-  double contact_ms = 0.0;       // time of the filter [ms], of it:
-  double contact_broad_ms = 0.0, contact_narrow_ms = 0.0, contact_response_ms = 0.0;  // its phases
-  int contact_response_iterations = 0;   // augmented-Lagrangian updates of the implicit response
-  long long contact_cg_iterations = 0;   // conjugate-gradient iterations in them
-  int contact_response_factorizations = 0;  // Cholesky factorisations of the response's Newton matrix
-  // The contact potential inside the step (StepPotential; zero without one).
-  int contact_newton_iterations = 0;  // linear solves of the step with the potential in them
+  // Contact's counts and times in this step (the velocity filter's and the potential's,
+  // sim/contact/contact_stage.hpp; zero without contact). contact.ms is all of contact's time.
+  ContactCounters contact;
+  // The contact potential's state at the end of the step (StepPotential; zero without one).
   int contact_active_pairs = 0;       // barrier pairs active at the end of the step
   int contact_friction_pairs = 0;     // pairs with lagged friction in the step
   double contact_energy = 0.0;        // the barrier's energy at the end of the step [J]
-  double contact_potential_ms = 0.0;  // evaluating the potential (part of contact_ms) [ms]
 };
 
 // The step's linear system as the solve left it, for a velocity filter that responds implicitly:

@@ -1,4 +1,4 @@
-// One finite-difference helper for every force term (sim/forces/force_term.hpp), used by the
+// One finite-difference helper for every force term (sim/core/force_term.hpp), used by the
 // tests of every term: the force against the central-difference gradient of the energy
 // (f = −∂E/∂x), and the matrix against the central-difference Jacobian of the force
 // (K = −∂f/∂x), column by column over the DOFs that are not derived from others.
@@ -11,7 +11,7 @@
 #pragma once
 
 #include "sim/discretization/discretization.hpp"
-#include "sim/forces/force_term.hpp"
+#include "sim/core/force_term.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>

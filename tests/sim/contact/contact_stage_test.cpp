@@ -44,7 +44,7 @@ constexpr double kG = 9.81;  // [m/s²]
 
 // Whether contact acted in a step: the barrier inside the step held pairs, or the fail-safe after
 // it gave impulses (with collision.method "constraints", every pair within the thickness).
-int contact_acted(const StepStats& s) { return s.contact_active_pairs + s.contact_impulses; }
+int contact_acted(const StepStats& s) { return s.contact_active_pairs + static_cast<int>(s.contact.impulses); }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -310,14 +310,14 @@ TEST(ContactNoContact, NoCollisionReportsNoContactFigures) {
   Simulator sim(p);
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
-    ASSERT_EQ(s.contact_pairs, 0) << "step " << i + 1;
-    ASSERT_EQ(s.contact_impulses, 0);
-    ASSERT_EQ(s.impact_zones, 0);
-    ASSERT_EQ(s.contact_unresolved, 0);
-    ASSERT_EQ(s.contact_ms, 0.0);
-    ASSERT_EQ(s.contact_broad_ms, 0.0);
-    ASSERT_EQ(s.contact_narrow_ms, 0.0);
-    ASSERT_EQ(s.contact_response_ms, 0.0);
+    ASSERT_EQ(s.contact.pairs_tested, 0) << "step " << i + 1;
+    ASSERT_EQ(s.contact.impulses, 0);
+    ASSERT_EQ(s.contact.impact_zones, 0);
+    ASSERT_EQ(s.contact.unresolved, 0);
+    ASSERT_EQ(s.contact.ms, 0.0);
+    ASSERT_EQ(s.contact.broad_ms, 0.0);
+    ASSERT_EQ(s.contact.narrow_ms, 0.0);
+    ASSERT_EQ(s.contact.response_ms, 0.0);
   }
   EXPECT_LT(sim.state().positions().col(2).minCoeff(), -1e-3);  // it did move
 }
@@ -344,10 +344,10 @@ TEST(ContactNoContact, FarObstaclesLeaveTheRunBitIdentical) {
     SCOPED_TRACE(name);
     ASSERT_TRUE(p.has_contact());
     Simulator a(reference), b(p);
-    int impulses = 0;
+    long long impulses = 0;
     for (int i = 0; i < a.num_steps(); ++i) {
       a.step();
-      impulses += b.step().contact_impulses;
+      impulses += b.step().contact.impulses;
       ASSERT_TRUE(a.state().x == b.state().x) << "step " << i + 1 << ": positions differ by "
                                               << (a.state().x - b.state().x).cwiseAbs().maxCoeff();
       ASSERT_TRUE(a.state().v == b.state().v) << "step " << i + 1 << ": velocities differ by "
@@ -376,7 +376,7 @@ struct DropRun {
   int most_elastic_step = 0;
   double largest_rise = 0.0;  // of kinetic + elastic + gravity's potential from one step to the next [J]
   int rise_step = 0;
-  int impulses = 0, unresolved = 0;
+  long long impulses = 0, unresolved = 0;
   double seconds = 0.0;
   double drop_energy() const { return mass * kG * drop; }  // [J]
 };
@@ -400,7 +400,7 @@ DropRun drop_on_ground(double friction, double tolerance = CollisionSettings{}.t
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
     run.impulses += contact_acted(s);
-    run.unresolved += s.contact_unresolved;
+    run.unresolved += s.contact.unresolved;
     const Eigen::VectorXd z = drawn_points(sim, op).col(2);
     if (z.minCoeff() < run.lowest) {
       run.lowest = z.minCoeff();
@@ -435,7 +435,7 @@ TEST(ContactPlane, DroppedClothComesToRestOnTheGround) {
   const DropRun run = drop_on_ground(0.5);
   const double t = run.thickness;
   std::printf("dropped cloth: lowest drawn point %.3e m (step %d; must be ≥ %.1e), at rest %.3e … %.3e m above the ground "
-              "(band %.1e … %.1e), kinetic energy %.2e J (bound %.2e J), fastest node %.2e m/s (bound %.2e); %d impulses; %.2f s\n",
+              "(band %.1e … %.1e), kinetic energy %.2e J (bound %.2e J), fastest node %.2e m/s (bound %.2e); %lld impulses; %.2f s\n",
               run.lowest, run.lowest_step, 0.1 * t, run.end_low, run.end_high, 0.1 * t, 2 * t, run.end_kinetic,
               0.5 * run.mass * std::pow(kG * run.dt, 2), run.fastest, kG * run.dt, run.impulses, run.seconds);
   EXPECT_GT(run.impulses, 0);
@@ -514,7 +514,7 @@ SlopeRun slide(double theta_deg, double mu, double duration) {
   run.lowest = std::numeric_limits<double>::infinity();
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
-    EXPECT_EQ(s.contact_unresolved, 0) << "step " << i + 1;
+    EXPECT_EQ(s.contact.unresolved, 0) << "step " << i + 1;
     run.lowest = std::min(run.lowest, (drawn_points(sim, op) * normal).minCoeff());
   }
   const Eigen::Vector3d moved = centre_of_mass(sim) - c0;
@@ -602,7 +602,7 @@ struct CollisionRun {
   bool built = false;
   int first_contact = 0;   // step of the first impulse
   double dt = 0.0, push_until = 0.01;
-  int impulses = 0, zones = 0, unresolved = 0;
+  long long impulses = 0, zones = 0, unresolved = 0;
   double scale = 0.0;      // Σ m |v| when the push ends [kg·m/s]
   double p0 = 0.0;         // |Σ m v| at the start [kg·m/s]
   double worst_momentum = 0.0;  // max |Σ m v − p0| / scale after the push
@@ -643,9 +643,9 @@ CollisionRun collide_patches() {
   double previous_kinetic = 0.0, previous_elastic = 0.0;
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
-    run.unresolved += s.contact_unresolved;
+    run.unresolved += s.contact.unresolved;
     run.impulses += contact_acted(s);
-    run.zones += s.impact_zones;
+    run.zones += s.contact.impact_zones;
     if (contact_acted(s) > 0 && run.first_contact == 0) run.first_contact = i + 1;
     // (the barrier's energy with the elastic: both are potential energies of the positions)
     const double kinetic = sim.kinetic_energy(), elastic = sim.elastic_energy() + sim.contact_energy();
@@ -680,7 +680,7 @@ TEST(ContactMomentum, CollidingClothPartsKeepTheirTotalMomentum) {
   // Σ m_v v_v stays what it was at the start, to 1e-9 of Σ m_v |v_v| (the size of the motion).
   const CollisionRun run = collide_patches();
   ASSERT_TRUE(run.built);
-  std::printf("colliding patches: first impulse at step %d (t = %.3f s), %d impulses, %d impact zones, %d unresolved; worst "
+  std::printf("colliding patches: first impulse at step %d (t = %.3f s), %lld impulses, %lld impact zones, %lld unresolved; worst "
               "momentum change %.2e of Σ m|v| = %.3e kg·m/s (step %d; |p0| = %.3e); %lld self-intersecting pairs; %.2f s\n",
               run.first_contact, run.first_contact * run.dt, run.impulses, run.zones, run.unresolved, run.worst_momentum,
               run.scale, run.worst_momentum_step, run.p0, run.self_pairs, run.seconds);
@@ -716,7 +716,7 @@ struct IntersectionTally {
   int first_bad_step = 0;
   std::string first_bad;  // what was seen at the first bad step
   double lowest = std::numeric_limits<double>::infinity();  // lowest drawn point in front of a plane [m]
-  int unresolved = 0, impulses = 0, zones = 0;
+  long long unresolved = 0, impulses = 0, zones = 0;
   double contact_ms = 0.0, check_seconds = 0.0;
 };
 
@@ -728,10 +728,10 @@ IntersectionTally run_and_check(Simulator& sim, const Problem& p, int level) {
   IntersectionTally tally;
   for (int i = 0; i < sim.num_steps(); ++i) {
     const StepStats s = sim.step();
-    tally.unresolved += s.contact_unresolved;
+    tally.unresolved += s.contact.unresolved;
     tally.impulses += contact_acted(s);
-    tally.zones += s.impact_zones;
-    tally.contact_ms += s.contact_ms;
+    tally.zones += s.contact.impact_zones;
+    tally.contact_ms += s.contact.ms;
     const auto t0 = std::chrono::steady_clock::now();
     ++tally.steps;
     const double t = sim.state().t;
@@ -773,7 +773,7 @@ IntersectionTally run_and_check(Simulator& sim, const Problem& p, int level) {
 
 void report(const char* name, const IntersectionTally& t, double seconds) {
   std::printf("%s: %d steps checked, self-intersecting pairs %lld, cloth–obstacle pairs %lld, lowest point %.3e m in front "
-              "of the ground, %d impulses, %d impact zones, %d unresolved; contact %.2f s, checks %.2f s, total %.2f s%s%s\n",
+              "of the ground, %lld impulses, %lld impact zones, %lld unresolved; contact %.2f s, checks %.2f s, total %.2f s%s%s\n",
               name, t.steps, t.self_pairs, t.obstacle_pairs, t.lowest, t.impulses, t.zones, t.unresolved, 1e-3 * t.contact_ms,
               t.check_seconds, seconds, t.first_bad.empty() ? "" : "; first: ", t.first_bad.c_str());
 }
@@ -855,7 +855,7 @@ TEST(ContactCulling, FlatRegionsDropPairsButChangeNothing) {
     Run r;
     for (int i = 0; i < sim.num_steps(); ++i) {
       const StepStats s = sim.step();
-      r.pairs += s.contact_pairs;
+      r.pairs += s.contact.pairs_tested;
       r.impulses += contact_acted(s);
     }
     r.x = sim.state().x;

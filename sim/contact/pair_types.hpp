@@ -1,0 +1,84 @@
+// The pairs the contact stage works with: candidate pairs of primitives from the broad phase,
+// distance bounds over a list of them, the geometry of a pair at one instant, and a pair's
+// constraint on the node velocities (sim/contact/contact_stage.hpp has how they are used).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace clothsim::contact {
+
+// A narrow-phase pair. Points and triangles index the collision surface ("cloth") or the
+// obstacles' combined mesh ("obstacle"); edges likewise.
+enum class Kind : std::uint8_t {
+  cloth_point_cloth_triangle,
+  cloth_edge_cloth_edge,
+  cloth_point_obstacle_triangle,
+  obstacle_point_cloth_triangle,
+  cloth_edge_obstacle_edge,
+};
+
+struct Candidate {
+  Kind kind;
+  int a, b;  // point and triangle, or edge and edge, in the order of the kind's name
+  bool near = false;  // from triangles near each other at rest: CCD only, at a tiny separation
+  bool operator<(const Candidate& o) const {
+    return std::tie(kind, a, b) < std::tie(o.kind, o.a, o.b);
+  }
+  bool operator==(const Candidate& o) const { return kind == o.kind && a == o.a && b == o.b; }
+};
+
+// Lower bounds of the distances of a list of candidate pairs at some configuration
+// (ContactStage::Impl::reference_bounds), and those below a reach.
+struct Bounds {
+  std::vector<double> lower;    // per candidate [m]
+  std::vector<size_t> close;    // the candidates whose bound is below `reach`
+  double reach = 0.0;           // [m]
+  void make_close(double r) {
+    reach = r;
+    close.clear();
+    for (size_t i = 0; i < lower.size(); ++i)
+      if (lower[i] < r) close.push_back(i);
+  }
+  // The bounds less `motion` (at least 0): the bounds after every point moved by at most that.
+  std::vector<double> less(double motion) const {
+    std::vector<double> out(lower.size());
+    for (size_t i = 0; i < lower.size(); ++i) out[i] = std::max(0.0, lower[i] - motion);
+    return out;
+  }
+};
+
+// Geometry of one pair at one instant: up to four points on each side with coefficients
+// (relative position = Σ c_k p_k, cloth points first), a unit normal from the second primitive
+// to the first, and their distance.
+struct PairGeometry {
+  int num = 0;                        // points in use
+  std::array<int, 4> point{};         // point index (cloth or obstacle, see `obstacle`)
+  std::array<bool, 4> obstacle{};     // whether the point is an obstacle vertex
+  std::array<double, 4> coef{};       // +1 / weights on the first primitive, −weights on the second
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double distance = 0.0;
+};
+
+// A contact constraint in DOF space: the relative velocity of the pair is
+// u = Σ_dof B[dof] v[dof] + u_obstacle (3-vectors B), so an impulse λ along a unit direction e
+// changes v[dof] by W[dof] λ (B[dof]·e).
+struct Constraint {
+  std::vector<std::pair<int, Eigen::Vector3d>> b;  // (dof, B[dof])
+  Eigen::Vector3d obstacle_velocity = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double target = 0.0;    // wanted normal relative velocity [m/s]
+  double mu = 0.0;        // friction coefficient
+  double lambda = 0.0;    // accumulated normal impulse [N·s]
+  Eigen::Vector3d friction = Eigen::Vector3d::Zero();  // accumulated tangential impulse [N·s]
+  int obstacle = -1;      // obstacle involved, or −1
+};
+
+}  // namespace clothsim::contact

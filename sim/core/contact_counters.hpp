@@ -1,0 +1,41 @@
+// What contact did over a step or over a run: counts and times that add up. The contact stage
+// reports them per step, the integrator adds its own times, and the application sums them into
+// the run's totals (summary.json, the checkpoint) and writes them per step (stats.csv), each with
+// `+=`. A new counter is a member here, a line in operator+=, and a column or key where it is
+// written.
+#pragma once
+
+namespace clothsim {
+
+struct ContactCounters {
+  long long pairs_tested = 0;             // narrow-phase pairs (point–triangle, edge–edge) examined
+  long long impulses = 0;                 // pairs given a normal impulse, plus friction impulses applied
+  long long impact_zones = 0;             // zones the fail-safe moved as one
+  long long unresolved = 0;               // pairs still colliding when the fail-safe gave up (should be 0)
+  long long response_iterations = 0;      // augmented-Lagrangian updates of the implicit response
+  long long response_cg_iterations = 0;   // conjugate-gradient iterations in them
+  long long response_factorizations = 0;  // factorisations of the response's Newton matrix
+  long long newton_iterations = 0;        // linear solves of the step with the contact potential in them
+  double ms = 0.0;                        // all of contact's time [ms]; of it:
+  double broad_ms = 0.0, narrow_ms = 0.0, response_ms = 0.0;  // the fail-safe's phases [ms]
+  double potential_ms = 0.0;              // evaluating the contact potential inside the step [ms]
+
+  ContactCounters& operator+=(const ContactCounters& o) {
+    pairs_tested += o.pairs_tested;
+    impulses += o.impulses;
+    impact_zones += o.impact_zones;
+    unresolved += o.unresolved;
+    response_iterations += o.response_iterations;
+    response_cg_iterations += o.response_cg_iterations;
+    response_factorizations += o.response_factorizations;
+    newton_iterations += o.newton_iterations;
+    ms += o.ms;
+    broad_ms += o.broad_ms;
+    narrow_ms += o.narrow_ms;
+    response_ms += o.response_ms;
+    potential_ms += o.potential_ms;
+    return *this;
+  }
+};
+
+}  // namespace clothsim
