@@ -223,8 +223,9 @@ struct ContactStage::Impl {
       tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p0.rows(), 2048), [&](const tbb::blocked_range<Eigen::Index>& range) {
         for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
           double x = 0.0, y = 0.0, z = 0.0;
-          for (const auto& [node, w] : point_rows[static_cast<size_t>(p)].nodes) {
-            const double* vn = v.data() + 3 * static_cast<Eigen::Index>(node);
+          for (int k = point_offsets[static_cast<size_t>(p)]; k < point_offsets[static_cast<size_t>(p) + 1]; ++k) {
+            const double w = point_weights[static_cast<size_t>(k)];
+            const double* vn = v.data() + 3 * static_cast<Eigen::Index>(point_nodes[static_cast<size_t>(k)]);
             x += w * vn[0];
             y += w * vn[1];
             z += w * vn[2];
@@ -1299,6 +1300,8 @@ struct ContactStage::Impl {
   // empty rows when some point's row does not have that form, and pair_row takes the long way).
   std::vector<NodeRow> point_rows;
   bool point_rows_in_node_form = false;
+  std::vector<int> point_offsets, point_nodes;  // the same rows packed (CSR), for end_points_of
+  std::vector<double> point_weights;
   void make_point_rows() {
     point_rows.assign(static_cast<size_t>(rest_points.rows()), NodeRow{});
     point_rows_in_node_form = true;
@@ -1311,6 +1314,16 @@ struct ContactStage::Impl {
       }
       std::sort(row.nodes.begin(), row.nodes.end());
       point_rows[static_cast<size_t>(p)] = std::move(row);
+    }
+    point_offsets.assign(1, 0);
+    point_nodes.clear();
+    point_weights.clear();
+    for (const NodeRow& row : point_rows) {
+      for (const auto& [node, w] : row.nodes) {
+        point_nodes.push_back(node);
+        point_weights.push_back(w);
+      }
+      point_offsets.push_back(static_cast<int>(point_nodes.size()));
     }
   }
   // The row of a pair's relative position over the nodes, Σ_k c_k J_k (cloth points only).
@@ -1373,14 +1386,12 @@ struct ContactStage::Impl {
   // The largest distance of a point p_i from the segment a_i → b_i [m] (infinite for other sizes).
   static double sweep_distance(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
     if (p.rows() != a.rows() || p.rows() != b.rows()) return std::numeric_limits<double>::infinity();
-    double worst = 0.0;
-    for (Eigen::Index i = 0; i < p.rows(); ++i) {
-      const Eigen::RowVector3d d = b.row(i) - a.row(i), q = p.row(i) - a.row(i);
-      const double dd = d.squaredNorm();
-      const double s = dd > 0 ? std::clamp(q.dot(d) / dd, 0.0, 1.0) : 0.0;
-      worst = std::max(worst, (q - s * d).squaredNorm());
-    }
-    return std::sqrt(worst);
+    if (p.rows() == 0) return 0.0;
+    // (Column by column, so that it vectorises: it runs several times per step.)
+    const Eigen::ArrayX3d d = (b - a).array(), q = (p - a).array();
+    const Eigen::ArrayXd dd = d.square().rowwise().sum();
+    const Eigen::ArrayXd s = (dd > 0).select(((q * d).rowwise().sum() / dd).max(0.0).min(1.0), 0.0);
+    return std::sqrt((q - d.colwise() * s).square().rowwise().sum().maxCoeff());
   }
   // Whether the candidates serve surface points p (and, when not null, q: any move between the
   // two) with the obstacles anywhere over this step (obstacles_serve, checked once per step).
@@ -1391,12 +1402,26 @@ struct ContactStage::Impl {
            (q == nullptr || sweep_distance(*q, built_p0, potential_guess) <= r);
   }
   bool candidates_serve() const { return candidates_serve(p0, &p1); }
+  // The same for the end points p of velocities v, remembering the last velocities found served
+  // (the step bound's end of a move is the next linearisation's point, and its start the last
+  // one's): the check is a few passes over all surface points, and it runs several times a step.
+  Eigen::VectorXd served_velocity;
+  bool served_known = false;  // served_velocity's end points are served by the current candidates
+  bool served(const Eigen::VectorXd& v, const Eigen::MatrixX3d& p) {
+    if (!obstacles_serve) return false;
+    if (served_known && v.size() == served_velocity.size() && v == served_velocity) return true;
+    if (!(sweep_distance(p, built_p0, potential_guess) <= serve_radius())) return false;
+    served_velocity = v;
+    served_known = true;
+    return true;
+  }
   void check_obstacles_serve() {
     const double r = serve_radius();
     obstacles_serve = sweep_distance(o0, built_o0, built_o1) <= r && sweep_distance(o1, built_o0, built_o1) <= r;
   }
   void make_potential_candidates(ContactReport& report) {
     lin_bounds_valid = false;
+    served_known = false;
     candidate_grow = settings.thickness + 2.0 * serve_radius();
     potential_cands = candidates(report);
     candidate_grow = 0.0;
@@ -1613,6 +1638,7 @@ struct ContactStage::Impl {
     for (Eigen::Index p = 0; p < p0.rows(); ++p) plane_stiffness[static_cast<size_t>(p)] = barrier_ratio() * point_mass(p) / (h * h);
     ContactReport scratch;
     check_obstacles_serve();
+    served_known = false;  // (a new start)
     if (candidates_serve()) {
       prepare_candidates();
     } else {
@@ -1693,7 +1719,7 @@ struct ContactStage::Impl {
     }
     // Candidates made for other end points serve while no point is more than half the
     // thickness from the path they were made for (their boxes are grown by twice the thickness).
-    if (!candidates_serve(p1, nullptr)) {
+    if (!served(v, p1)) {
       ContactReport scratch;
       make_potential_candidates(scratch);
     }
@@ -1771,14 +1797,20 @@ struct ContactStage::Impl {
 
   double step_bound(const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
     const bool at_linearisation = lin_bounds_valid && from.size() == lin_velocity.size() && from == lin_velocity;
-    const Eigen::MatrixX3d pa = at_linearisation ? lin_points : end_points_of(from), pb = end_points_of(to);
+    // (End points known already are not made again: the last linearisation's, or those of the
+    // velocities the step began with.)
+    auto points_of = [&](const Eigen::VectorXd& w) {
+      if (end_points_current && w.size() == p1_velocity.size() && w == p1_velocity) return Eigen::MatrixX3d(p1);
+      return end_points_of(w);
+    };
+    const Eigen::MatrixX3d pa = at_linearisation ? lin_points : points_of(from), pb = points_of(to);
     bound_to_velocity = to;
     bound_to_points = pb;
     // Candidates for the move pa → pb: the potential's where they serve it, else a broad phase
     // over this move.
     const std::vector<Candidate>* cands = &potential_cands;
     std::vector<Candidate> own;
-    if (!candidates_serve(pa, &pb)) {
+    if (!(served(from, pa) && served(to, pb))) {
       const Eigen::MatrixX3d start_points = p0, end_points = p1;
       const bool boxes = obstacle_boxes_current;
       p0 = pa;
@@ -1933,7 +1965,10 @@ struct ContactStage::Impl {
       // Proximity is the potential's, inside the step (begin_potential / linearise); here only the
       // fail-safe, on the potential's candidates where they serve this step's motion
       // (candidates_serve).
-      if (candidates_serve()) {
+      // (Within the potential's step its start is served: begin_potential checked it, or made the
+      // candidates from it.)
+      const bool same_step = potential_step_start == std::pair{t, step} && x.size() == potential_x.size() && x == potential_x;
+      if (same_step ? served(v, p1) : candidates_serve()) {
         cands = potential_cands;
         use_bounds = true;
       } else {

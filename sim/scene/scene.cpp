@@ -722,6 +722,22 @@ Motion read_motion(const Reader& r, const Json& item, const std::string& path) {
   return m;
 }
 
+// A boundary translated by more than this many times the mesh's size (its bounding-box diagonal)
+// is refused: no cloth scene moves a boundary that far, and such a motion (a slip in an exponent:
+// -1e9 m) stretched the cloth past anything the contact and the solver can follow, growing to
+// gigabytes before it failed with a message that named no key.
+constexpr double kMaxTravel = 1000.0;
+
+void check_travel(const Reader& r, const Motion& m, const std::string& path, const TriMesh& mesh) {
+  if (m.type != Motion::Type::translate || mesh.vertices.rows() == 0) return;
+  const double size = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).norm();
+  const double travel = m.displacement.stableNorm();  // (finite for components near the largest double)
+  if (travel <= kMaxTravel * size) return;
+  r.fail(join_key(path, "displacement"), "moves the boundary by " + format_number(travel) + " m, more than " +
+                                             format_number(kMaxTravel) + " times the mesh's size (" + format_number(size) +
+                                             " m, its bounding-box diagonal); is the unit metres?");
+}
+
 // `select`: {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} → the control vertices in the
 // closed box (at least one).
 std::vector<int> read_selection(const Reader& r, const Json& item, const std::string& path, const TriMesh& mesh) {
@@ -777,8 +793,10 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
       const std::string motion_path = join_key(path, "motion");
       if (!dynamic) r.fail(motion_path, kNeedsDynamic);
       r.array(*motion, motion_path);
-      for (std::size_t m = 0; m < motion->size(); ++m)
+      for (std::size_t m = 0; m < motion->size(); ++m) {
         bc.motion.push_back(read_motion(r, (*motion)[m], join_index(motion_path, m)));
+        check_travel(r, bc.motion.back(), join_index(motion_path, m), mesh);
+      }
       if (!bc.motion.empty() && !bc.fix[0] && !bc.fix[1] && !bc.fix[2])
         r.fail(motion_path, "has no effect: the motion drives the fixed components and \"fix\" is empty");
     }

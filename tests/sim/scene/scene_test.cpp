@@ -613,6 +613,14 @@ TEST_F(SceneLoader, MotionErrors) {
             expected("boundary[0].motion[1].end: required key is missing"));
   EXPECT_TRUE(contains(motion(R"([{"type": "hold", "start": 0, "end": 1}])", "[]"),
                        expected("boundary[0].motion: has no effect")));
+  // A translation beyond a thousand times the mesh's size (the 4 x 4 grid: 1 m square, diagonal
+  // sqrt 2 m) is a unit or exponent slip; it once grew to gigabytes before the solver failed.
+  EXPECT_EQ(motion(R"([{"type": "translate", "displacement": [0, -1e9, 0], "start": 0, "end": 1}])"),
+            expected(m0 + ".displacement: moves the boundary by 1000000000.0 m, more than 1000.0 times the mesh's size "
+                          "(1.4142135623730951 m, its bounding-box diagonal); is the unit metres?"));
+  EXPECT_TRUE(contains(motion(R"([{"type": "translate", "displacement": [1e308, 1e308, 0], "start": 0, "end": 1}])"),
+                       expected(m0 + ".displacement: moves the boundary by")));
+  EXPECT_EQ(motion(R"([{"type": "translate", "displacement": [0, 1000, 0], "start": 0, "end": 1}])"), "no error");
   // An empty chain is allowed (the components stay at rest) and so is a partial fix.
   EXPECT_EQ(motion("[]"), "no error");
   EXPECT_EQ(motion(R"([{"type": "translate", "displacement": [0, 1, 0], "start": 0, "end": 1}])", R"(["y"])"), "no error");
