@@ -543,6 +543,11 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
     throw std::runtime_error("--resume " + run_dir.string() + ": the checkpoint is at step " +
                              std::to_string(first_step) + ", beyond the run's " + std::to_string(steps) + " steps");
   std::vector<std::string> warnings = settings_warnings(scene, steps);
+  if (const long long joined = sim->contact_joined_at_rest(); joined > 0)
+    warnings.push_back("contact: " + std::to_string(joined) +
+                       " pairs of drawn triangles touch at rest without being neighbours in the mesh (a surface that "
+                       "meets itself, such as a panel rolled to almost 360 degrees); they make no contact pairs: the "
+                       "cloth is taken to be joined there");
   for (const std::string& w : warnings) log_line("warning: " + w);
   std::vector<int> unresolved_steps;  // steps that ended with contact pairs still colliding
   if (resume)

@@ -94,6 +94,13 @@ struct ContactStage::Impl {
   std::vector<std::vector<int>> patch_points;      // the fine points of each patch
   std::vector<std::array<int, 3>> patch_corners;   // the surface triangle under each patch
   std::vector<std::vector<int>> near_at_rest;      // per fine triangle a: the sorted b > a near it at rest
+  // Per fine triangle a: the sorted b > a that touch it at rest (closer than the near separation)
+  // without being neighbours in the material (their patches share no control vertex): a surface
+  // that meets itself at rest, such as a panel rolled to 359.9999999999°. Such pairs start
+  // colliding and could never be separated, so they make no pairs at all: the cloth is taken to be
+  // joined there (ContactStage::joined_at_rest reports how many).
+  std::vector<std::vector<int>> joined_at_rest;
+  long long joined_pairs = 0;
   std::vector<std::vector<int>> vertex_patches;    // per control node: the patches that have it as a corner
   std::vector<std::vector<std::pair<int, int>>> control_edges;  // per control node: (neighbour, edge id)
   size_t num_control_edges = 0;
@@ -300,14 +307,27 @@ struct ContactStage::Impl {
     const std::vector<std::pair<int, int>> pairs = rest_broad.self_pairs(boxes);
     // The predicate in parallel (one flag per pair), the lists in the pairs' order: the same
     // lists as a serial pass.
-    std::vector<char> is_near(pairs.size(), 0);
+    std::vector<char> is_near(pairs.size(), 0), is_joined(pairs.size(), 0);
+    const double joined = params.near_separation_ratio * settings.thickness;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i)
-        is_near[i] = near_pair(surface.triangles[static_cast<size_t>(pairs[i].first)],
-                               surface.triangles[static_cast<size_t>(pairs[i].second)], near);
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const auto& a = surface.triangles[static_cast<size_t>(pairs[i].first)];
+        const auto& b = surface.triangles[static_cast<size_t>(pairs[i].second)];
+        is_near[i] = near_pair(a, b, near);
+        if (!is_near[i]) continue;
+        const auto& pa = d.control_triangles()[static_cast<size_t>(pairs[i].first / fine_per_patch)];
+        const auto& pb = d.control_triangles()[static_cast<size_t>(pairs[i].second / fine_per_patch)];
+        is_joined[i] = !shares_vertex(pa, pb) && triangle_distance(rest_points, a, b) < joined;
+      }
     });
-    for (size_t i = 0; i < pairs.size(); ++i)
+    joined_at_rest.assign(surface.triangles.size(), {});
+    for (size_t i = 0; i < pairs.size(); ++i) {
       if (is_near[i]) near_at_rest[static_cast<size_t>(pairs[i].first)].push_back(pairs[i].second);
+      if (is_joined[i]) {
+        joined_at_rest[static_cast<size_t>(pairs[i].first)].push_back(pairs[i].second);
+        ++joined_pairs;
+      }
+    }
     // sorted: the pairs come sorted
   }
 
@@ -490,6 +510,8 @@ struct ContactStage::Impl {
     auto add_triangle_pair = [&](int i, int j, bool neighbours, std::vector<Candidate>& into) {  // i < j
       const std::vector<int>& near_i = near_at_rest[static_cast<size_t>(i)];
       const bool near = neighbours || std::binary_search(near_i.begin(), near_i.end(), j);
+      const std::vector<int>& joined_i = joined_at_rest[static_cast<size_t>(i)];
+      if (near && std::binary_search(joined_i.begin(), joined_i.end(), j)) return;
       const auto& ti = surface.triangles[static_cast<size_t>(i)];
       const auto& tj = surface.triangles[static_cast<size_t>(j)];
       // (Triangles sharing a vertex still make pairs of their other points and edges: a point is
@@ -2103,6 +2125,7 @@ double ContactStage::velocity_tolerance(double h) const {
 }
 
 const SurfaceOperator& ContactStage::surface() const { return impl_->surface; }
+long long ContactStage::joined_at_rest() const { return impl_->joined_pairs; }
 const std::vector<Obstacle>& ContactStage::obstacles() const { return impl_->obstacles; }
 
 }  // namespace clothsim

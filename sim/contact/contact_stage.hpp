@@ -113,6 +113,10 @@ class ContactStage {
 
   // The collision surface (the display operator at surface_level) and its points at x.
   const SurfaceOperator& surface() const;
+  // Pairs of drawn triangles that touch at rest (closer than a hundredth of the thickness) without
+  // being neighbours in the material: a surface that meets itself at rest. They are left out of
+  // the contact (the cloth is taken to be joined there); 0 without self-collision.
+  long long joined_at_rest() const;
   const std::vector<Obstacle>& obstacles() const;
 
  private:

@@ -30,6 +30,7 @@ class ContactFilter final : public VelocityFilter, public StepPotential {
     if (settings.barrier) stage_.enable_potential();
   }
   bool inside_step() const { return stage_.potential_enabled(); }
+  long long joined_at_rest() const { return stage_.joined_at_rest(); }
   void begin_step(const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t, double h,
                   const Eigen::VectorXd& diagonal) override {
     stage_.begin_step(x, v_guess, t, h, diagonal);
@@ -181,6 +182,7 @@ double Simulator::elastic_energy() const { return impl_->integrator->elastic_ene
 double Simulator::external_work() const { return impl_->integrator->external_work(); }
 double Simulator::boundary_work() const { return impl_->integrator->boundary_work(); }
 double Simulator::contact_energy() const { return impl_->integrator->potential_energy(); }
+long long Simulator::contact_joined_at_rest() const { return impl_->contact ? impl_->contact->joined_at_rest() : 0; }
 double Simulator::max_membrane_strain() const {
   return impl_->discretization->max_membrane_strain(impl_->integrator->displacement());
 }

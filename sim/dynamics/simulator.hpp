@@ -73,6 +73,9 @@ class Simulator {
   // collision.method "constraints"): a potential energy of the positions, part of the mechanical
   // energy with kinetic and elastic (docs/contact.md, "Contact inside the step").
   double contact_energy() const;
+  // Pairs of drawn triangles left out of the self-collision because they touch at rest without
+  // being neighbours in the material (ContactStage::joined_at_rest); 0 without contact.
+  long long contact_joined_at_rest() const;
   // Largest |principal Green–Lagrange membrane strain| of the surface in the current state [-]
   // (Discretization::max_membrane_strain: for loop_kl of the limit surface at the element
   // barycentres, for linear_fe and mass_spring of the flat triangles); computed on demand, a pass
