@@ -728,12 +728,13 @@ Motion read_motion(const Reader& r, const Json& item, const std::string& path) {
 // gigabytes before it failed with a message that named no key.
 constexpr double kMaxTravel = 1000.0;
 
-void check_travel(const Reader& r, const Motion& m, const std::string& path, const TriMesh& mesh) {
+void check_travel(const Reader& r, const Motion& m, const std::string& path, const TriMesh& mesh,
+                  const char* what = "the boundary") {
   if (m.type != Motion::Type::translate || mesh.vertices.rows() == 0) return;
   const double size = (mesh.vertices.colwise().maxCoeff() - mesh.vertices.colwise().minCoeff()).norm();
   const double travel = m.displacement.stableNorm();  // (finite for components near the largest double)
   if (travel <= kMaxTravel * size) return;
-  r.fail(join_key(path, "displacement"), "moves the boundary by " + format_number(travel) + " m, more than " +
+  r.fail(join_key(path, "displacement"), std::string("moves ") + what + " by " + format_number(travel) + " m, more than " +
                                              format_number(kMaxTravel) + " times the mesh's size (" + format_number(size) +
                                              " m, its bounding-box diagonal); is the unit metres?");
 }
@@ -1443,6 +1444,11 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   const Json& mesh_json = r.require(root, "", "mesh");
   TriMesh mesh = build_mesh(r, mesh_json, file.parent_path(), say, max_vertices);
   warn_about_cracks(mesh, mesh_json.contains("obj"), say);
+  // An obstacle's translations too are measured against the cloth (the scene's scale).
+  for (std::size_t i = 0; i < scene.problem.obstacles.size(); ++i)
+    for (std::size_t m = 0; m < scene.problem.obstacles[i].motion.size(); ++m)
+      check_travel(r, scene.problem.obstacles[i].motion[m], join_index(join_key(join_index("obstacles", i), "motion"), m), mesh,
+                   "the obstacle");
   try {
     scene.problem.mesh = prepare_mesh(scene.problem.method, mesh, say);
   } catch (const std::exception& e) {

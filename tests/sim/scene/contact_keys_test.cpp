@@ -288,6 +288,11 @@ TEST_F(ContactKeys, ObstacleValueErrors) {
   EXPECT_EQ(error(with_obstacles(R"([{"primitive": "sphere", "center": [0, 0, 0], "radius": 0.1,
                                      "motion": [{"type": "hold", "start": 2, "end": 1}]}])")),
             expected("obstacles[0].motion[0].end: must be >= start = 2.0 [s] (got 1.0)"));
+  // A translation beyond a thousand times the cloth's size (the 0.2 m grid: diagonal 0.28 m).
+  EXPECT_TRUE(contains(error(with_obstacles(R"([{"primitive": "sphere", "center": [0, -1, 0], "radius": 0.1,
+      "motion": [{"type": "translate", "displacement": [0, -1e9, 0], "start": 0, "end": 1}]}])")),
+                       expected("obstacles[0].motion[0].displacement: moves the obstacle by 1000000000.0 m, more than "
+                                "1000.0 times the mesh's size")));
   EXPECT_EQ(error(with_obstacles(R"([{"primitive": "sphere", "center": [0, 0, 0], "radius": 0.1,
                                      "motion": [{"type": "spin", "start": 0, "end": 1}]}])")),
             expected("obstacles[0].motion[0].type: unknown motion type \"spin\" (allowed: \"rotate\", \"translate\", \"hold\")"));
