@@ -1302,7 +1302,10 @@ struct ContactStage::Impl {
     double bound = 0.0;  // μ λ [N]
   };
   std::vector<FrictionRow> friction_rows;
-  std::map<std::pair<int, int>, size_t> closest;  // scratch: (cloth point, obstacle) -> candidate
+  // Scratch of keep_closest: per (cloth point, obstacle), the closest candidate so far (+1; 0 for
+  // none), and the entries set.
+  std::vector<size_t> closest;
+  std::vector<size_t> closest_set;
   Eigen::VectorXd potential_x;                    // the step's start positions (begin_potential)
   std::pair<double, double> potential_step_start{-1.0, 0.0};  // its t and h
   Eigen::VectorXd p1_velocity;                    // the velocities p1 was made from
@@ -1513,21 +1516,28 @@ struct ContactStage::Impl {
   // Of the flagged cloth-point–obstacle-triangle candidates, keeps (flagged) the closest triangle
   // per point and obstacle.
   void keep_closest(std::vector<char>& flagged, const std::vector<PairGeometry>& geometry_of) {
-    closest.clear();
+    const size_t num_obstacles = obstacles.size();
+    closest.resize(static_cast<size_t>(p0.rows()) * num_obstacles, 0);
     for (size_t i = 0; i < potential_cands.size(); ++i) {
       const Candidate& c = potential_cands[i];
       if (!flagged[i] || c.kind != Kind::cloth_point_obstacle_triangle) continue;
       const int obstacle = obs.obstacle_of_vertex[static_cast<size_t>(obs.triangles[static_cast<size_t>(c.b)][0])];
-      auto [it, inserted] = closest.emplace(std::pair{c.a, obstacle}, i);
-      if (inserted) continue;
-      size_t& best = it->second;
+      const size_t key = static_cast<size_t>(c.a) * num_obstacles + static_cast<size_t>(obstacle);
+      if (closest[key] == 0) {
+        closest[key] = i + 1;
+        closest_set.push_back(key);
+        continue;
+      }
+      const size_t best = closest[key] - 1;
       if (geometry_of[i].distance < geometry_of[best].distance) {
         flagged[best] = 0;
-        best = i;
+        closest[key] = i + 1;
       } else {
         flagged[i] = 0;
       }
     }
+    for (size_t key : closest_set) closest[key] = 0;
+    closest_set.clear();
   }
 
   std::vector<PairGeometry> cand_start;  // per candidate, at the start of the step
