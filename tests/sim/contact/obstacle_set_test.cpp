@@ -38,6 +38,17 @@ Obstacle capsule() {
   return o;
 }
 
+// The unit square z = 0 as an open mesh obstacle, split along the diagonal 0–2.
+Obstacle square(const char* name) {
+  Obstacle o;
+  o.name = name;
+  o.shape = Obstacle::Shape::mesh;
+  o.mesh.vertices.resize(4, 3);
+  o.mesh.vertices << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return o;
+}
+
 int owned_edge_count(const ObstacleSet& s) {
   int n = 0;
   for (const auto& owned : s.owned_edges) n += static_cast<int>(owned.size());
@@ -98,13 +109,7 @@ TEST(ObstacleSet, CapsuleEdgesBendByTheTessellationStep) {
 }
 
 TEST(ObstacleSet, OpenMeshBorderEdgesCountAsSharp) {
-  Obstacle o;
-  o.name = "sheet";
-  o.shape = Obstacle::Shape::mesh;
-  o.mesh.vertices.resize(4, 3);
-  o.mesh.vertices << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
-  o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
-  std::vector<Obstacle> obstacles = {o};
+  std::vector<Obstacle> obstacles = {square("sheet")};
   const ObstacleSet s(obstacles);
   int border = 0;
   for (size_t e = 0; e < s.edges.size(); ++e)
@@ -125,13 +130,7 @@ TEST(ObstacleSet, MeshObstacleWithoutTrianglesIsAnError) {
 TEST(ObstacleSet, PointBesideAFlatDiagonalIsRedundant) {
   // The square z = 0 split along the diagonal 0–2: a point above triangle 1 (x < y), closest to
   // triangle 0 (x > y) on their shared diagonal, adds nothing through triangle 0.
-  Obstacle o;
-  o.name = "square";
-  o.shape = Obstacle::Shape::mesh;
-  o.mesh.vertices.resize(4, 3);
-  o.mesh.vertices << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
-  o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
-  std::vector<Obstacle> obstacles = {o};
+  std::vector<Obstacle> obstacles = {square("square")};
   const ObstacleSet s(obstacles);
   const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(1, 1, 0);
   // The point (0.3, 0.5, 0.1): closest point on triangle 0 is on its edge 2–0 (weight of b zero),
