@@ -1354,6 +1354,21 @@ struct ContactStage::Impl {
   // The row of a pair's relative position over the nodes, Σ_k c_k J_k (cloth points only).
   NodeRow pair_row(const PairGeometry& g) {
     if (!point_rows_in_node_form) return node_row(constraint(g));
+    // One cloth point (against an obstacle or a plane): its row, scaled (the same values as the
+    // merge below gives, without it).
+    int cloth = -1, count = 0;
+    for (int k = 0; k < g.num; ++k)
+      if (!g.obstacle[static_cast<size_t>(k)] && g.coef[static_cast<size_t>(k)] != 0.0) {
+        cloth = k;
+        ++count;
+      }
+    if (count == 1) {
+      NodeRow row = point_rows[static_cast<size_t>(g.point[static_cast<size_t>(cloth)])];
+      const double coef = g.coef[static_cast<size_t>(cloth)];
+      if (coef != 1.0)
+        for (auto& entry : row.nodes) entry.second *= coef;
+      return row;
+    }
     NodeRow row;
     for (int k = 0; k < g.num; ++k) {
       const double coef = g.coef[static_cast<size_t>(k)];
