@@ -2005,7 +2005,8 @@ struct ContactStage::Impl {
     // pairs that start closer than the minimum separation are pushed apart by a fraction of the
     // shortfall per step.
     const double eta = params.min_separation_ratio * settings.thickness;
-    std::vector<Candidate> cands;
+    std::vector<Candidate> own;  // this step's own broad phase, where the potential's do not serve
+    const std::vector<Candidate>* cands = &own;
     bool cands_current = true;  // made for the current end points
     bool use_bounds = false;    // cands are the potential's, with their distance bounds
     if (potential_on) {
@@ -2016,15 +2017,15 @@ struct ContactStage::Impl {
       // candidates from it.)
       const bool same_step = potential_step_start == std::pair{t, step} && x.size() == potential_x.size() && x == potential_x;
       if (same_step ? served(v, p1) : candidates_serve()) {
-        cands = potential_cands;
+        cands = &potential_cands;  // (read in place, not copied)
         use_bounds = true;
       } else {
         candidate_grow = 0.0;
-        cands = candidates(report);
+        own = candidates(report), cands = &own;
       }
     } else {
-      cands = candidates(report);
-      constraints = proximity(cands, t, report);
+      own = candidates(report), cands = &own;
+      constraints = proximity(*cands, t, report);
       warm_start(constraints);
       report.proximity_pairs = static_cast<int>(constraints.size());
       for (Found& f : constraints) f.constraint.target = params.repulsion_ratio * std::max(0.0, eta - f.distance) / h;
@@ -2044,20 +2045,20 @@ struct ContactStage::Impl {
       const bool changed = !end_points_current;  // impulses since the candidates were made
       update_end_points(v);
       report.narrow_ms += ms_since(t0);
-      if (!cands_current || changed) cands = candidates(report);
+      if (!cands_current || changed) own = candidates(report), cands = &own;
       cands_current = false;  // the response below moves the end points
       if (pass == 0 && use_bounds) {
         double obstacle_motion = 0.0, motion = 0.0;
         const Bounds& bounds = reference_bounds(p0, &p1, true, obstacle_motion, motion);
-        hits = collisions(cands, t, report, nullptr, nullptr, &last_hits, &bounds, obstacle_motion, motion);
+        hits = collisions(*cands, t, report, nullptr, nullptr, &last_hits, &bounds, obstacle_motion, motion);
       } else if (pass == 0) {
-        hits = collisions(cands, t, report, nullptr, nullptr, &last_hits);
+        hits = collisions(*cands, t, report, nullptr, nullptr, &last_hits);
       } else {
         moved.assign(static_cast<size_t>(p1.rows()), 0);
         for (Eigen::Index p = 0; p < p1.rows(); ++p) moved[static_cast<size_t>(p)] = p1.row(p) != p1_tested.row(p);
         std::vector<Candidate> previous;
         previous.swap(last_hits);
-        hits = collisions(cands, t, report, &moved, &previous, &last_hits);
+        hits = collisions(*cands, t, report, &moved, &previous, &last_hits);
       }
       p1_tested = p1;
       report.ccd_collisions += static_cast<int>(hits.size());
@@ -2077,8 +2078,8 @@ struct ContactStage::Impl {
       update_end_points(v);
       report.narrow_ms += ms_since(t0);
       if (round > 0) {
-        cands = candidates(report);
-        hits = collisions(cands, t, report);
+        own = candidates(report), cands = &own;
+        hits = collisions(*cands, t, report);
         if (hits.empty()) return report;
       }
       for (const Found& f : hits) {
