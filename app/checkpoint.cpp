@@ -14,8 +14,8 @@ namespace {
 constexpr std::string_view kMagic = "clothsim checkpoint\n";
 constexpr std::string_view kEnd = "end\n";
 // 2: RunTotals::contact_response_factorizations; 3: the coupled pattern; 4: RunTotals::contact as
-// ContactCounters.
-constexpr std::uint32_t kVersion = 4;
+// ContactCounters; 5: ContactCounters::relinearisations.
+constexpr std::uint32_t kVersion = 5;
 
 class Writer {
  public:

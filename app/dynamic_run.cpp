@@ -205,7 +205,8 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                     {"response_factorizations", totals.contact.response_factorizations},
                     {"method", scene.problem.collision.barrier ? "barrier" : "constraints"},
                     {"barrier_seconds", totals.contact.potential_ms / 1000.0},
-                    {"newton_iterations", totals.contact.newton_iterations}};
+                    {"newton_iterations", totals.contact.newton_iterations},
+                    {"relinearisations", totals.contact.relinearisations}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -220,7 +221,7 @@ class Outputs {
     if (resume) return;
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms") +
-                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy" : ""));
+                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy,contact_relinearisations" : ""));
     probes_.flush();
     stats_.flush();
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
@@ -327,7 +328,8 @@ class Outputs {
            {std::to_string(s.contact.pairs_tested), std::to_string(s.contact.impulses), std::to_string(s.contact.impact_zones),
             std::to_string(s.contact.unresolved), format_double(s.contact.ms), std::to_string(s.contact.response_iterations),
             std::to_string(s.contact.response_cg_iterations), std::to_string(s.contact.response_factorizations),
-            std::to_string(s.contact.newton_iterations), std::to_string(s.contact_active_pairs), format_double(s.contact_energy)})
+            std::to_string(s.contact.newton_iterations), std::to_string(s.contact_active_pairs), format_double(s.contact_energy),
+            std::to_string(s.contact.relinearisations)})
         row.append(1, ',').append(field);
     stats_.line(row);  // flushed by record_state, together with the probes
   }

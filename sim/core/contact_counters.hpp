@@ -16,6 +16,8 @@ struct ContactCounters {
   long long response_cg_iterations = 0;   // conjugate-gradient iterations in them
   long long response_factorizations = 0;  // factorisations of the response's Newton matrix
   long long newton_iterations = 0;        // linear solves of the step with the contact potential in them
+  long long relinearisations = 0;         // steps solved again with the elastic terms re-linearised at
+                                          // their end positions (rotations that turned within the step)
   double ms = 0.0;                        // all of contact's time [ms]; of it:
   double broad_ms = 0.0, narrow_ms = 0.0, response_ms = 0.0;  // the fail-safe's phases [ms]
   double potential_ms = 0.0;              // evaluating the contact potential inside the step [ms]
@@ -29,6 +31,7 @@ struct ContactCounters {
     response_cg_iterations += o.response_cg_iterations;
     response_factorizations += o.response_factorizations;
     newton_iterations += o.newton_iterations;
+    relinearisations += o.relinearisations;
     ms += o.ms;
     broad_ms += o.broad_ms;
     narrow_ms += o.narrow_ms;

@@ -50,6 +50,12 @@ class ForceTerm {
   virtual bool has_energy() const { return false; }
   virtual double energy() const { return 0.0; }  // [J]
 
+  // The largest turn of a local frame the term is linearised about (a corotated element's
+  // rotation) from the update() before the last one to the last [rad]; 0 for a term without such
+  // frames or when the last update() reused the state before it. The integrator re-linearises a
+  // step in contact while it exceeds the solver's tolerance (sim/integrator/implicit_euler.hpp).
+  virtual double frame_turn() const { return 0.0; }
+
   // f += f₀ at the last update() [N].
   virtual void add_force(Eigen::VectorXd& f) const = 0;
 

@@ -10,6 +10,9 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -160,6 +163,7 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
   rest_a1_.resize(count);
   rest_a2_.resize(count);
   rotation_.assign(count, Eigen::Matrix3d::Identity());
+  turn_cosine_.assign(count, 1.0);
   local_energy_.assign(count, 0.0);
   // K_e for the assembly (see build_assembly): packed upper blocks of K_e, or of Tᵀ K_e T for a
   // componentwise fold T = W ⊗ I₃; the dense K_e of the other folded elements.
@@ -347,9 +351,16 @@ void CorotationalElements::evaluate(const Eigen::VectorXd& u) {
         a1 += rows[2 * p] * x.segment<3>(3 * p);
         a2 += rows[2 * p + 1] * x.segment<3>(3 * p);
       }
+      const Eigen::Matrix3d previous = rotation_[e];
       extract_rotation(rest_a1_[e], rest_a2_[e], a1, a2, rotation_[e]);  // keeps the last R if degenerate
+      // cos of the angle of Rₒₗ𝒹ᵀ R: (trace − 1) / 2.
+      turn_cosine_[e] = 0.5 * (previous.cwiseProduct(rotation_[e]).sum() - 1.0);
     }
   });
+  double cosine = 1.0;
+  if (corotational_ && !frozen_rotations_)
+    for (size_t e = 0; e < count; ++e) cosine = std::min(cosine, turn_cosine_[e]);
+  rotation_change_ = std::acos(std::clamp(cosine, -1.0, 1.0));
   rotate_ms_ = ms_since(t0);
   total_rotate_ms_ += rotate_ms_;
   const auto t1 = std::chrono::steady_clock::now();

@@ -78,6 +78,10 @@ class CorotationalElements {
   // Its exact Jacobian is minus the tension-stiffening matrix G (for derivative checks) [N].
   Eigen::VectorXd tension_force(const Eigen::VectorXd& u) const;
 
+  // The largest angle by which an element's rotation turned in the last evaluate() against the
+  // one before it [rad] (0 without corotation or with frozen rotations).
+  double last_rotation_change() const { return rotation_change_; }
+
   double last_rotate_ms() const { return rotate_ms_; }
   double total_rotate_ms() const { return total_rotate_ms_; }  // over every evaluate() so far
   double last_force_ms() const { return force_ms_; }
@@ -106,6 +110,8 @@ class CorotationalElements {
   std::vector<char> identity_;
   std::vector<Eigen::Vector3d> rest_a1_, rest_a2_;
   std::vector<Eigen::Matrix3d> rotation_;
+  std::vector<double> turn_cosine_;  // per element, cos of its rotation's turn in the last evaluate()
+  double rotation_change_ = 0.0;
   // Per quadrature point (element e's from point_offset_[e]): membrane and bending strain
   // matrices at rest (3 × 3·#patch each, column-major, one after the other from
   // strain_offset_), K_m·H, D_b·H and weight·j.

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -79,6 +80,7 @@ struct Simulator::Impl {
     settings.dt = problem.time.dt;
     settings.newton_iterations = problem.solver.newton_iterations;
     settings.extrapolated_start = problem.solver.extrapolated_start;
+    settings.rotation_tolerance = problem.solver.rotation_tolerance_deg * std::numbers::pi / 180.0;
     integrator = std::make_unique<ImplicitEuler>(settings, *discretization, node_mass, terms, loads->empty() ? nullptr : loads.get(),
                                                  boundary, solver, state);
     if (problem.has_contact()) {

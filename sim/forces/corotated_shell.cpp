@@ -9,8 +9,10 @@ CorotatedShell::CorotatedShell(const ShellModel& model, bool corotational, bool 
 
 void CorotatedShell::update(const Eigen::VectorXd& /*x*/, const Eigen::VectorXd& u, double /*t*/) {
   rotate_ms_ = force_ms_ = 0.0;
+  turn_ = 0.0;
   if (evaluated_ && u.size() == last_u_.size() && u == last_u_) return;
   elements_.evaluate(u);
+  turn_ = elements_.last_rotation_change();
   last_u_ = u;
   evaluated_ = true;
   rotate_ms_ = elements_.last_rotate_ms();

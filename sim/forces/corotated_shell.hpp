@@ -23,6 +23,7 @@ class CorotatedShell final : public ForceTerm {
   bool has_energy() const override { return true; }
   double energy() const override { return elements_.energy(); }
   void add_force(Eigen::VectorXd& f) const override { f += elements_.force(); }
+  double frame_turn() const override { return turn_; }
   bool has_matrix() const override { return true; }
   void add_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const override;
   void set_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const override;
@@ -42,6 +43,7 @@ class CorotatedShell final : public ForceTerm {
   bool evaluated_ = false;
   Eigen::VectorXd last_u_;
   double rotate_ms_ = 0.0, force_ms_ = 0.0;
+  double turn_ = 0.0;  // the elements' largest turn in the last update() [rad]
 };
 
 }  // namespace clothsim

@@ -27,6 +27,7 @@ class KelvinVoigtDamping final : public ForceTerm {
   bool has_energy() const override { return elastic_->has_energy(); }
   double energy() const override { return elastic_->energy(); }  // the elastic term's [J]
   void add_force(Eigen::VectorXd& f) const override { elastic_->add_force(f); }
+  double frame_turn() const override { return elastic_->frame_turn(); }
   bool has_matrix() const override { return true; }
   // a += (w_K + c w_D) K + w_D D_elastic.
   void add_matrix(const MatrixWeights& w, Eigen::SparseMatrix<double>& a) const override;

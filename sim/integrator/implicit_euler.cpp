@@ -85,11 +85,11 @@ IntegratorCheckpoint ImplicitEuler::checkpoint() const {
 
 LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b,
                                                       const Eigen::VectorXd& x, const Eigen::VectorXd& v_now, double t,
-                                                      double h, Eigen::VectorXd& v, StepStats& stats) {
+                                                      double h, bool first, Eigen::VectorXd& v, StepStats& stats) {
   const Eigen::Index n3 = v.size();
   auto clock = [] { return std::chrono::steady_clock::now(); };
   auto t0 = clock();
-  potential_->begin_step(x, v, t, h, a.diagonal());
+  if (first) potential_->begin_step(x, v, t, h, a.diagonal());
   // Newton starts where the surfaces have not passed through each other: the start's move of the
   // free components from the step's start positions is cut at the first crossing (the positions
   // at the start of the step are free of crossings; prescribed components move as scripted).
@@ -106,10 +106,11 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
   // is not going (Newton iterations per step on sheet_on_sphere's first 0.5 s / sleeve_on_arm's
   // first 0.2 s: always from the guess 4.20 / 3.03, always from the velocities 3.52 / 2.79, this
   // rule 3.80 / 3.02).
-  feasible(v);
   PotentialLinearisation lin;
+  if (first) feasible(v);
   potential_->linearise(v, lin);
-  if (!lin.empty()) {
+  if (!lin.empty()) potential_acted_ = true;
+  if (first && !lin.empty()) {
     for (Eigen::Index i = 0; i < n3; ++i)
       if (free_[static_cast<size_t>(i)]) v(i) = v_now(i);
     feasible(v);
@@ -177,6 +178,7 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
     // crossings).
     t0 = clock();
     potential_->linearise(v_new, next);
+    if (!lin.empty() || !next.empty()) potential_acted_ = true;
     if (lin.empty() && next.empty()) {
       // Nothing at either end: the solve minimised Φ, which is the step's quadratic there.
       potential_ms += ms_since(t0);
@@ -218,21 +220,26 @@ LinearSolveReport ImplicitEuler::solve_with_potential(const Eigen::SparseMatrix<
     // cannot get closer than that.)
     if (change <= tolerance || r.iterations == 0 || iterations >= kMaxNewton) break;
   }
-  t0 = clock();
-  PotentialReport report;
-  report.newton_iterations = iterations;
-  report.active_pairs = lin.active;
-  report.energy = lin.energy;
-  potential_->end_step(v, report);
-  potential_ms += ms_since(t0);
-  stats.contact.newton_iterations += report.newton_iterations;
-  stats.contact_active_pairs = report.active_pairs;
-  stats.contact_friction_pairs = report.friction_pairs;
-  stats.contact_energy = report.energy;
+  stats.contact.newton_iterations += iterations;
+  stats.contact_active_pairs = lin.active;
+  stats.contact_energy = lin.energy;
   stats.contact.potential_ms += potential_ms;
   stats.contact.ms += potential_ms;
   stats.solve_ms -= potential_ms;  // (the caller times the whole call as the solve)
   return total;
+}
+
+void ImplicitEuler::finish_potential(const Eigen::VectorXd& v, StepStats& stats) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PotentialReport report;
+  report.newton_iterations = static_cast<int>(stats.contact.newton_iterations);
+  report.active_pairs = stats.contact_active_pairs;
+  report.energy = stats.contact_energy;
+  potential_->end_step(v, report);
+  stats.contact_friction_pairs = report.friction_pairs;
+  const double ms = ms_since(t0);
+  stats.contact.potential_ms += ms;
+  stats.contact.ms += ms;
 }
 
 void ImplicitEuler::update_terms(const Eigen::VectorXd& x, const Eigen::VectorXd& u, double t) {
@@ -257,6 +264,17 @@ double ImplicitEuler::elastic_energy() const {
   for (const ForceTerm* term : internal_)
     if (term->has_energy()) e += term->energy();
   return e;
+}
+
+void ImplicitEuler::end_positions(const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd& target,
+                                 Eigen::VectorXd& x_end, Eigen::VectorXd& u_end) const {
+  const double h = settings_.dt;
+  const std::vector<int>& prescribed = boundary_.dofs();
+  x_end = x + h * v;
+  for (size_t i = 0; i < prescribed.size(); ++i) x_end(prescribed[i]) = target(static_cast<Eigen::Index>(i));
+  u_end = x_end - discretization_.rest();
+  discretization_.make_consistent(u_end);
+  x_end = discretization_.rest() + u_end;
 }
 
 StepStats ImplicitEuler::step(DynamicState& state) {
@@ -297,10 +315,20 @@ StepStats ImplicitEuler::step(DynamicState& state) {
   std::vector<std::vector<std::pair<Eigen::Index, double>>> prescribed_rows(prescribed.size());
   Eigen::VectorXd prescribed_rhs(static_cast<Eigen::Index>(prescribed.size()));
   Eigen::VectorXd x_lin, u_lin;
-  for (int k = 0; k < settings_.newton_iterations; ++k) {
+  // Rotations follow the step where contact acts: once the requested iterations are done, the
+  // terms are evaluated at the step's end positions (as the step's end does anyway); where a
+  // frame turned by more than the tolerance against the one the step was linearised with, the
+  // step is solved again, linearised there (a Newton iteration on the nonlinear step with the
+  // potential in it), up to kMaxRelinearisations times.
+  constexpr int kMaxRelinearisations = 4;
+  bool relinearised = false;  // the terms are already evaluated where iteration k linearises
+  potential_acted_ = false;
+  for (int k = 0;; ++k) {
     auto t0 = std::chrono::steady_clock::now();
     try {
-      if (k == 0) {
+      if (relinearised) {
+        // (evaluated below, at x_lin)
+      } else if (k == 0) {
         update_terms(x, u_, t_next);  // (terms that depend on x alone reuse the last evaluation)
       } else {
         x_lin = x + h * v_k;
@@ -313,6 +341,7 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     } catch (const std::exception& e) {
       throw SimulationError(step_number, t_next, e.what());
     }
+    relinearised = false;
     stats.update_ms += ms_since(t0);
 
     t0 = std::chrono::steady_clock::now();
@@ -342,10 +371,9 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     stats.assemble_ms += ms_since(t0);
 
     t0 = std::chrono::steady_clock::now();
-    const bool last = k + 1 == settings_.newton_iterations;
-    const LinearSolveReport report = potential_ && last ? solve_with_potential(a, b, x, v, state.t, h, v_next, stats)
-                                                        : solver_.solve(a, b, free_, v_next);
-    if (!(potential_ && last)) coupled_in_use_ = false;
+    const LinearSolveReport report = potential_ ? solve_with_potential(a, b, x, v, state.t, h, k == 0, v_next, stats)
+                                                : solver_.solve(a, b, free_, v_next);
+    if (!potential_) coupled_in_use_ = false;
     stats.solver_iterations += report.iterations;
     stats.residual = report.residual;
     stats.factorizations += report.factorizations;
@@ -354,7 +382,23 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     if (!report.converged) throw SimulationError(step_number, t_next, report.failure, SimulationError::Kind::solver);
     if (k > 0) stats.newton_change = (v_next - v_k).norm() / std::max(v_next.norm(), 1e-300);
     v_k = v_next;
+    if (k + 1 < settings_.newton_iterations) continue;
+    if (!potential_acted_ || k + 1 >= settings_.newton_iterations + kMaxRelinearisations) break;
+    t0 = std::chrono::steady_clock::now();
+    end_positions(x, v_next, target, x_lin, u_lin);
+    try {
+      update_terms(x_lin, u_lin, t_next);
+    } catch (const std::exception& e) {
+      throw SimulationError(step_number, t_next, e.what());
+    }
+    stats.update_ms += ms_since(t0);
+    double turn = 0.0;
+    for (const ForceTerm* term : all_) turn = std::max(turn, term->frame_turn());
+    if (turn <= settings_.rotation_tolerance) break;
+    relinearised = true;
+    ++stats.contact.relinearisations;
   }
+  if (potential_) finish_potential(v_next, stats);
 
   if (filter_) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -370,11 +414,8 @@ StepStats ImplicitEuler::step(DynamicState& state) {
   }
 
   // Advance; scripted components land exactly on their motion, tied ones follow their rule.
-  Eigen::VectorXd x_next = x + h * v_next;
-  for (size_t i = 0; i < prescribed.size(); ++i) x_next(prescribed[i]) = target(static_cast<Eigen::Index>(i));
-  Eigen::VectorXd u_next = x_next - rest;
-  discretization_.make_consistent(u_next);
-  x_next = rest + u_next;
+  Eigen::VectorXd x_next, u_next;
+  end_positions(x, v_next, target, x_next, u_next);
   for (int dof : dependent_) v_next(dof) = (x_next(dof) - x(dof)) / h;
   if (!x_next.allFinite() || !v_next.allFinite())
     throw SimulationError(step_number, t_next, "the state became NaN or infinite (numerical instability)",

@@ -31,6 +31,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -54,6 +55,12 @@ struct IntegratorSettings {
   // The iterative solver's start: the last velocity extrapolated by its last change,
   // v + (v − v_prev) (constant acceleration), or the last velocity itself.
   bool extrapolated_start = true;
+  // Where contact acts in a step (the step potential is something), the step is linearised again
+  // at its end positions while a force term's frame (a corotated element) turned by more than this
+  // between the linearisation and the end positions [rad] (ForceTerm::frame_turn), up to four
+  // times: the rotations follow a fast impact within the step. Infinite: never (a scene sets it
+  // from solver.rotation_tolerance_deg).
+  double rotation_tolerance = std::numeric_limits<double>::infinity();
 };
 
 // Per-step figures (one row of stats.csv).
@@ -229,9 +236,19 @@ class ImplicitEuler {
   double potential_energy_ = 0.0;
   // Newton on the incremental potential with the step potential in it (step_potential.hpp):
   // v holds the caller's start (and the fixed components) and receives the result, v_now is the
-  // velocity at the start of the step; a and b are the elastic system.
+  // velocity at the start of the step; a and b are the elastic system. `first`: the step's first
+  // linearisation of the elastic terms (the potential starts its step; later ones continue from
+  // v, already free of crossings). Sets potential_acted_ where the potential is something.
   LinearSolveReport solve_with_potential(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
-                                         const Eigen::VectorXd& v_now, double t, double h, Eigen::VectorXd& v, StepStats& stats);
+                                         const Eigen::VectorXd& v_now, double t, double h, bool first, Eigen::VectorXd& v,
+                                         StepStats& stats);
+  // Ends the potential's step at the accepted velocities v.
+  void finish_potential(const Eigen::VectorXd& v, StepStats& stats);
+  // The end positions of velocities v from x, as the step's end makes them: scripted components
+  // at `target`, tied ones by their rule; x_end and u_end = x_end − rest.
+  void end_positions(const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd& target,
+                     Eigen::VectorXd& x_end, Eigen::VectorXd& u_end) const;
+  bool potential_acted_ = false;  // the step potential was something in this step's Newton iterates
 };
 
 }  // namespace clothsim

@@ -39,6 +39,10 @@ struct DampingSettings {
 // the integrator's and elastic term's numerical options.
 struct SolverSettings : LinearSolverSettings {
   int newton_iterations = 1;  // linear solves per step; > 1 re-extracts rotations (accuracy studies)
+  // In a step where contact acts, the step is solved again with the rotations re-extracted at its
+  // end positions while an element turned by more than this within it [deg]
+  // (IntegratorSettings::rotation_tolerance).
+  double rotation_tolerance_deg = 6.0;
   bool tension_stiffening = true;  // membrane geometric stiffness in the matrix (corotational_elements.hpp)
   // pcg's start: the last velocity extrapolated by its last change, v + (v − v_prev)
   // (constant acceleration), or the last velocity itself.

@@ -78,6 +78,8 @@ std::optional<ProblemIssue> find_issue(const Problem& p, Analysis analysis) {
   if (!(p.solver.tolerance > 0 && p.solver.tolerance < 1)) return ProblemIssue{"solver.tolerance", "must be > 0 and < 1"};
   if (p.solver.max_iterations < 1) return ProblemIssue{"solver.max_iterations", "must be an integer >= 1"};
   if (p.solver.newton_iterations < 1) return ProblemIssue{"solver.newton_iterations", "must be an integer >= 1"};
+  if (!(p.solver.rotation_tolerance_deg > 0 && p.solver.rotation_tolerance_deg <= 180))
+    return ProblemIssue{"solver.rotation_tolerance_deg", "must be > 0 and <= 180 [deg]"};
   if (p.solver.refresh_iterations < 1) return ProblemIssue{"solver.refresh_iterations", "must be an integer >= 1"};
   return std::nullopt;
 }

@@ -894,8 +894,8 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   SolverSettings s;
   if (j == nullptr) return s;
   r.check_object(*j, "solver",
-                 {"type", "tolerance", "max_iterations", "newton_iterations", "preconditioner", "refresh_iterations",
-                  "tension_stiffening", "warm_start"});
+                 {"type", "tolerance", "max_iterations", "newton_iterations", "rotation_tolerance_deg", "preconditioner",
+                  "refresh_iterations", "tension_stiffening", "warm_start"});
   if (const Json* v = r.find(*j, "type")) {
     const std::string type = r.choice(*v, "solver.type", {"auto", "pcg", "cholmod"}, "solver type");
     s.type = type == "cholmod" ? LinearSolverType::cholmod
@@ -910,6 +910,11 @@ SolverSettings read_solver(const Reader& r, const Json* j) {
   if (const Json* v = r.find(*j, "max_iterations")) s.max_iterations = r.integer_at_least(*v, "solver.max_iterations", 1);
   if (const Json* v = r.find(*j, "newton_iterations"))
     s.newton_iterations = r.integer_at_least(*v, "solver.newton_iterations", 1);
+  if (const Json* v = r.find(*j, "rotation_tolerance_deg")) {
+    s.rotation_tolerance_deg = r.number(*v, "solver.rotation_tolerance_deg");
+    if (!(s.rotation_tolerance_deg > 0 && s.rotation_tolerance_deg <= 180))
+      r.fail("solver.rotation_tolerance_deg", "must be > 0 and <= 180 [deg] (got " + v->dump() + ")");
+  }
   if (const Json* v = r.find(*j, "preconditioner")) {
     const std::string p = r.choice(*v, "solver.preconditioner", {"auto", "block_jacobi", "cholesky"}, "preconditioner");
     s.preconditioner = p == "cholesky"       ? PreconditionerType::cholesky

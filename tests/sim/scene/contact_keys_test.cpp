@@ -594,7 +594,7 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
   };
   const std::string contact_columns =
       ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,"
-      "response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy";
+      "response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy,contact_relinearisations";
   const std::string header_with = first_line(out() / "touch" / "stats.csv");
   const std::string header_without = first_line(out() / "free" / "stats.csv");
   EXPECT_EQ(header_with.size() >= contact_columns.size() &&

@@ -548,7 +548,12 @@ TEST_F(SceneLoader, DynamicSettingErrors) {
                        expected("solver.preconditioner: unknown preconditioner \"jacobi\" (allowed: \"auto\", \"block_jacobi\", \"cholesky\")")));
   EXPECT_TRUE(contains(with(R"("solver": {"precondition": "cholesky"})"),
                        expected("solver.precondition: unknown key (allowed: type, tolerance, max_iterations, "
-                                "newton_iterations, preconditioner, refresh_iterations, tension_stiffening, warm_start)")));
+                                "newton_iterations, rotation_tolerance_deg, preconditioner, refresh_iterations, "
+                                "tension_stiffening, warm_start)")));
+  EXPECT_EQ(with(R"("solver": {"rotation_tolerance_deg": 0})"),
+            expected("solver.rotation_tolerance_deg: must be > 0 and <= 180 [deg] (got 0)"));
+  EXPECT_EQ(with(R"("solver": {"rotation_tolerance_deg": 181})"),
+            expected("solver.rotation_tolerance_deg: must be > 0 and <= 180 [deg] (got 181)"));
   EXPECT_TRUE(contains(with(R"("solver": {"warm_start": "zero"})"),
                        expected("solver.warm_start: unknown warm start \"zero\" (allowed: \"extrapolated\", \"last_velocity\")")));
   EXPECT_EQ(with(R"("corotational": "yes")"), expected("corotational: expected true or false (got \"yes\")"));
