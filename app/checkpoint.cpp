@@ -14,7 +14,7 @@ namespace {
 constexpr std::string_view kMagic = "clothsim checkpoint\n";
 constexpr std::string_view kEnd = "end\n";
 // 2: RunTotals::contact_response_factorizations; 3: the coupled pattern; 4: RunTotals::contact as
-// ContactCounters; 5: ContactCounters::relinearisations.
+// ContactCounters; 5: ContactCounters::relinearisations, IntegratorCheckpoint::contact_last_step.
 constexpr std::uint32_t kVersion = 5;
 
 class Writer {
@@ -121,6 +121,7 @@ void write_checkpoint(const std::filesystem::path& path, const RunCheckpoint& c)
   w.put(s.integrator.external_work);
   w.put(s.integrator.boundary_work);
   w.put(flatten(s.integrator.coupled_pattern));
+  w.put(static_cast<std::uint8_t>(s.integrator.contact_last_step));
   w.put(s.solver.factored_values);
   w.put(static_cast<std::int64_t>(s.solver.solves_since_factor));
   w.put(s.solver.iterations_since_factor);
@@ -155,6 +156,7 @@ RunCheckpoint read_checkpoint(const std::filesystem::path& path) {
   s.integrator.external_work = r.get<double>();
   s.integrator.boundary_work = r.get<double>();
   s.integrator.coupled_pattern = unflatten(r.vector(), r);
+  s.integrator.contact_last_step = r.get<std::uint8_t>() != 0;
   s.solver.factored_values = r.vector();
   s.solver.solves_since_factor = static_cast<int>(r.get<std::int64_t>());
   s.solver.iterations_since_factor = r.get<double>();

@@ -147,6 +147,9 @@ struct IntegratorCheckpoint {
   // The coupled pattern of the last solve with a step potential (per node, the coupled nodes;
   // empty without one): the solver's factor is of a matrix with this pattern.
   std::vector<std::vector<int>> coupled_pattern;
+  // Whether the step potential was something in the last step (the next step's Newton then starts
+  // from the velocities, not the extrapolated guess).
+  bool contact_last_step = false;
 };
 
 class ImplicitEuler {
@@ -249,6 +252,7 @@ class ImplicitEuler {
   void end_positions(const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd& target,
                      Eigen::VectorXd& x_end, Eigen::VectorXd& u_end) const;
   bool potential_acted_ = false;  // the step potential was something in this step's Newton iterates
+  bool contact_last_step_ = false;  // ... in the last step's (the next step's Newton starts from v)
 };
 
 }  // namespace clothsim
