@@ -120,6 +120,8 @@ struct ContactStage::Impl {
   std::vector<Box> obstacle_boxes, obstacle_point_box, obstacle_edge_box;  // swept over the step
   bool obstacle_boxes_current = false;
   Eigen::MatrixX3d o0, o1;          // obstacle vertices at t and t + h
+  // No meshed obstacle moves: o0 = o1 and their boxes are the same every step (set at build).
+  bool obstacles_static = false;
   double h = 0.0;
 
   Impl(const Discretization& disc, const Eigen::VectorXd& mass, const std::vector<char>& free_dofs,
@@ -170,6 +172,8 @@ struct ContactStage::Impl {
     }
 
     obs = contact::ObstacleSet(obstacles);
+    obstacles_static = std::all_of(obstacles.begin(), obstacles.end(),
+                                   [](const Obstacle& o) { return o.shape == Obstacle::Shape::plane || o.motion.empty(); });
   }
 
   // A point–obstacle-triangle pair that adds nothing (contact::ObstacleSet::redundant_on_flat_face).
@@ -601,7 +605,7 @@ struct ContactStage::Impl {
       for (const std::vector<Candidate>& chunk : chunks) out.insert(out.end(), chunk.begin(), chunk.end());
     }
     if (!obs.triangles.empty()) {
-      if (!obstacle_boxes_current) {  // once per step: the obstacles' motion is known for the step
+      if (!obstacle_boxes_current) {  // once per step (once per run for static obstacles)
         obstacle_boxes.resize(obs.triangles.size());
         for (size_t t = 0; t < obs.triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obs.triangles[t], 0.0);
         obstacle_point_box.resize(obs.obstacle_of_vertex.size());
@@ -613,26 +617,38 @@ struct ContactStage::Impl {
         for (size_t e = 0; e < obs.edges.size(); ++e) {
           const Box& a = obstacle_point_box[static_cast<size_t>(obs.edges[e][0])];
           const Box& b = obstacle_point_box[static_cast<size_t>(obs.edges[e][1])];
-          obstacle_edge_box[e] = grown(Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)}, 0.5 * grow);
+          obstacle_edge_box[e] = Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)};  // (grown where used)
         }
         obstacle_boxes_current = true;
       }
       measure_smooth_tangents();
-      for (const auto& [q, j] : obstacle_broad.pairs(patch_box, obstacle_boxes))
+      const std::vector<std::pair<int, int>> obroad = obstacle_broad.pairs(patch_box, obstacle_boxes);
+      auto descend_obstacle = [&](int q, int j, std::vector<Candidate>& into) {
         for (int i = q * fine_per_patch; i < (q + 1) * fine_per_patch; ++i) {
           if (!overlap(grown(triangle_box(i), grow), obstacle_boxes[static_cast<size_t>(j)])) continue;
           for (int v : owned_points[static_cast<size_t>(i)])
             if (overlap(point_grown[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
-              out.push_back({Kind::cloth_point_obstacle_triangle, v, j});
+              into.push_back({Kind::cloth_point_obstacle_triangle, v, j});
           for (int v : obs.owned_points[static_cast<size_t>(j)])
             if (obs.vertex_tangent[static_cast<size_t>(v)] > smooth_tangent_triangle[static_cast<size_t>(i)] &&
                 overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), triangle_box(i)))
-              out.push_back({Kind::obstacle_point_cloth_triangle, v, i});
+              into.push_back({Kind::obstacle_point_cloth_triangle, v, i});
           for (int ea : owned_edges[static_cast<size_t>(i)])
             for (int eb : obs.owned_edges[static_cast<size_t>(j)])
-              if (obs.edge_tangent[static_cast<size_t>(eb)] > smooth_tangent_edge[static_cast<size_t>(ea)] && overlap(edge_swept(ea), obstacle_edge_box[static_cast<size_t>(eb)]))
-                out.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
+              if (obs.edge_tangent[static_cast<size_t>(eb)] > smooth_tangent_edge[static_cast<size_t>(ea)] &&
+                  overlap(edge_swept(ea), grown(obstacle_edge_box[static_cast<size_t>(eb)], 0.5 * grow)))
+                into.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
         }
+      };
+      // (In fixed chunks on both cores, joined in order, as the self pairs.)
+      constexpr size_t kChunk = 256;
+      std::vector<std::vector<Candidate>> chunks((obroad.size() + kChunk - 1) / kChunk);
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
+        for (size_t c = range.begin(); c != range.end(); ++c)
+          for (size_t k = c * kChunk; k < std::min(obroad.size(), (c + 1) * kChunk); ++k)
+            descend_obstacle(obroad[k].first, obroad[k].second, chunks[c]);
+      });
+      for (const std::vector<Candidate>& chunk : chunks) out.insert(out.end(), chunk.begin(), chunk.end());
     }
     // Every pair is made once (ownership) in an order fixed by the sorted broad-phase pairs, so
     // the list is deterministic without sorting.
@@ -1456,6 +1472,10 @@ struct ContactStage::Impl {
     return true;
   }
   void check_obstacles_serve() {
+    if (obstacles_static && built_o0.rows() == o0.rows()) {  // (o0 = o1 = built_o0 = built_o1)
+      obstacles_serve = true;
+      return;
+    }
     const double r = serve_radius();
     obstacles_serve = sweep_distance(o0, built_o0, built_o1) <= r && sweep_distance(o1, built_o0, built_o1) <= r;
   }
@@ -1675,14 +1695,16 @@ struct ContactStage::Impl {
     Eigen::VectorXd scale(d.num_nodes());
     for (int k = 0; k < d.num_nodes(); ++k) scale(k) = diagonal.segment<3>(3 * k).sum() / 3.0;
     point_mass.resize(p0.rows());
-    for (Eigen::Index p = 0; p < p0.rows(); ++p) {
-      double sum = 0.0;
-      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(jacobian, 3 * p); it; ++it)
-        sum += it.value() * it.value() / scale(it.col() / 3);
-      point_mass(p) = sum > 0 ? 1.0 / sum : std::numeric_limits<double>::infinity();
-    }
     plane_stiffness.resize(static_cast<size_t>(p0.rows()));
-    for (Eigen::Index p = 0; p < p0.rows(); ++p) plane_stiffness[static_cast<size_t>(p)] = barrier_ratio() * point_mass(p) / (h * h);
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p0.rows(), 1024), [&](const tbb::blocked_range<Eigen::Index>& range) {
+      for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
+        double sum = 0.0;
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(jacobian, 3 * p); it; ++it)
+          sum += it.value() * it.value() / scale(it.col() / 3);
+        point_mass(p) = sum > 0 ? 1.0 / sum : std::numeric_limits<double>::infinity();
+        plane_stiffness[static_cast<size_t>(p)] = barrier_ratio() * point_mass(p) / (h * h);
+      }
+    });
     ContactReport scratch;
     check_obstacles_serve();
     served_known = false;  // (a new start)
@@ -1963,8 +1985,9 @@ struct ContactStage::Impl {
     p0.resize(surface.position.rows(), 3);
     parallel_product(surface.position, net.data(), net.rows(), 3, p0.data());
     end_points_current = false;
-    obstacle_boxes_current = false;
-    if (!obs.obstacle_of_vertex.empty()) {
+    const bool placed = obstacles_static && o0.rows() == static_cast<Eigen::Index>(obs.obstacle_of_vertex.size());
+    if (!placed) obstacle_boxes_current = false;
+    if (!placed && !obs.obstacle_of_vertex.empty()) {
       o0.resize(static_cast<Eigen::Index>(obs.obstacle_of_vertex.size()), 3);
       o1.resize(o0.rows(), 3);
       for (size_t k = 0; k < obstacles.size(); ++k) {
