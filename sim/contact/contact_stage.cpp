@@ -1484,6 +1484,7 @@ struct ContactStage::Impl {
     served_known = false;
     candidate_grow = settings.thickness + 2.0 * serve_radius();
     potential_cands = candidates(report);
+    near_reach_of.assign(potential_cands.size(), -1.0);
     candidate_grow = 0.0;
     potential_guess = p1;
     built_p0 = p0;
@@ -1625,6 +1626,33 @@ struct ContactStage::Impl {
   // within 1.25 thicknesses (`close`) are visited at all.
   Bounds start_bounds, lin_bounds;
   double close_reach() const { return 1.25 * settings.thickness; }
+  // The barrier's reach for a near pair (parts near each other at rest, which CCD alone keeps
+  // from crossing): half the pair's distance at rest, at most the thickness, so that it exerts
+  // nothing at rest or anywhere the pair keeps half its rest distance, and resists a fold that
+  // presses neighbouring parts into each other (without it such a pair stops Newton only by
+  // cutting its steps: the crushed sleeve took 12 solves per step, each cut by an edge pair at
+  // 0.2 µm that had been 2 mm apart at rest). Computed once per candidate list, when first
+  // needed (each index by one thread).
+  std::vector<double> near_reach_of;
+  // The four points of a cloth–cloth pair (the only near pairs) in the rest state.
+  std::array<Eigen::Vector3d, 4> rest_corners(const Candidate& c) const {
+    auto rp = [&](int i) -> Eigen::Vector3d { return rest_points.row(i).transpose(); };
+    if (c.kind == Kind::cloth_edge_cloth_edge) {
+      const auto& ea = edges[static_cast<size_t>(c.a)];
+      const auto& eb = edges[static_cast<size_t>(c.b)];
+      return {rp(ea[0]), rp(ea[1]), rp(eb[0]), rp(eb[1])};
+    }
+    const auto& t = surface.triangles[static_cast<size_t>(c.b)];
+    return {rp(c.a), rp(t[0]), rp(t[1]), rp(t[2])};
+  }
+  double near_reach(size_t i) {
+    double& r = near_reach_of[i];
+    if (r < 0.0) {
+      const Candidate& c = potential_cands[i];
+      r = std::min(settings.thickness, 0.5 * geometry(c, rest_corners(c)).distance);
+    }
+    return r;
+  }
   // Calls visit(i), in parallel, for every candidate, or only for the close ones of `bounds` when
   // no pair can move from its bound to below `threshold` with moves of at most `motion` [m].
   template <class Visit>
@@ -1812,12 +1840,13 @@ struct ContactStage::Impl {
       const std::array<Eigen::Vector3d, 4> corner = corners(c, true);
       const double gap = box_gap(corner, is_point_triangle(c.kind));
       next.lower[i] = std::max(next.lower[i], gap);
-      if (c.near || gap > dhat) return;  // (most candidates: no exact distance)
+      const double reach = c.near ? near_reach(i) : dhat;
+      if (gap > reach) return;  // (most candidates: no exact distance)
       end[i] = geometry(c, corner);
       next.lower[i] = std::max(next.lower[i], end[i].distance);
       if (redundant_on_flat_face_pair(c, end[i], corner)) return;
-      if (end[i].distance < dhat) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
-      active[i] = end[i].distance < dhat;
+      if (end[i].distance < reach) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
+      active[i] = end[i].distance < reach;
     });
     next.make_close(close_reach());
     lin_bounds = std::move(next);
@@ -1825,8 +1854,8 @@ struct ContactStage::Impl {
     lin_velocity = v;
     lin_time = t + h;
     lin_bounds_valid = true;
-    auto add_pair = [&](NodeRow row, const Eigen::Vector3d& normal, double distance, double k) {
-      const contact::CubicBarrier barrier{dhat, k};
+    auto add_pair = [&](NodeRow row, const Eigen::Vector3d& normal, double distance, double k, double reach) {
+      const contact::CubicBarrier barrier{reach, k};
       out.energy += barrier.value(distance);
       PotentialLinearisation::Block block;
       block.row = std::move(row);
@@ -1840,13 +1869,15 @@ struct ContactStage::Impl {
     // over a face has several triangles within the thickness, and none of them twice).
     keep_closest(active, end);
     for (size_t i = 0; i < potential_cands.size(); ++i)
-      if (active[i]) add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]));
+      if (active[i])
+        add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]),
+                 potential_cands[i].near ? near_reach(i) : dhat);
     for (int k : obs.planes) {
       Eigen::Vector3d q1, n1;
       plane_at(obstacles[static_cast<size_t>(k)], t + h, q1, n1);
       for (Eigen::Index p = 0; p < p1.rows(); ++p) {
         const double dist = n1.dot(p1.row(p).transpose() - q1);
-        if (dist < dhat) add_pair(point_row(static_cast<int>(p)), n1, dist, plane_stiffness[static_cast<size_t>(p)]);
+        if (dist < dhat) add_pair(point_row(static_cast<int>(p)), n1, dist, plane_stiffness[static_cast<size_t>(p)], dhat);
       }
     }
     const contact::SmoothedFriction friction{friction_epsilon()};

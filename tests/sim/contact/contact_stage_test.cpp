@@ -901,7 +901,8 @@ TEST(ContactIntersections, SheetDrapedOverABoxStaysIntersectionFree) {
 
 // The flat-region cull (docs/contact.md) only drops pairs that cannot meet: the sheet draped over
 // the ball (folds, self-contact) runs the same with and without it, while testing far fewer
-// pairs.
+// pairs. (With the constraints method, whose narrow phase tests every candidate in every step:
+// with the barrier, distance bounds leave most candidates untested either way.)
 TEST(ContactCulling, FlatRegionsDropPairsButChangeNothing) {
   struct Run {
     Eigen::VectorXd x;
@@ -911,6 +912,7 @@ TEST(ContactCulling, FlatRegionsDropPairsButChangeNothing) {
   auto run = [](double angle) {
     Problem p = dropped_sheet(0.3, 12, Eigen::Vector3d(0, 0, 0.2), 0.4, {ground(0.5), sphere(Eigen::Vector3d(0, 0, 0.08), 0.08, 0.3)});
     p.collision.flat_region_angle = angle;
+    p.collision.barrier = false;
     Simulator sim(p);
     Run r;
     for (int i = 0; i < sim.num_steps(); ++i) {
@@ -1009,6 +1011,45 @@ TEST(ContactIntersections, SheetOnSphereSceneStaysIntersectionFree) {
   EXPECT_EQ(tally.obstacle_pairs, 0) << tally.first_bad;
   EXPECT_GT(tally.lowest, 0.0) << tally.first_bad;
   EXPECT_EQ(tally.unresolved, 0);
+}
+
+TEST(ContactNewton, CrushedSleeveConvergesWithoutTheFailSafe) {
+  // sleeve_compress (a cotton sleeve, self-collision on) crushed by 60 % of its length in 0.6 s on
+  // a coarser mesh (18 × 13): folds are pressed onto folds, and in sharp folds neighbouring parts
+  // of the surface (near each other at rest, kept from crossing by CCD alone until the barrier
+  // held them at half their rest distance) are pressed into each other. Newton then converges in
+  // a few solves per step, and the fail-safe has nothing to do. Measured: at most 4 solves in a
+  // step, 830 in 700 steps, 0 impulses; without the near pairs' barrier 996 solves, 15 steps above
+  // 4 and one at the cap of 12 (the full-size crush: 12 in every step from 0.8 s on).
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::filesystem::path file = std::filesystem::path(CLOTHSIM_SOURCE_DIR) / "scenes" / "sleeve_compress.json";
+  Scene scene = load_scene(file, nullptr,
+                           {"boundary[1].motion[0].displacement=[0,-0.12,0]", "boundary[1].motion[0].end=0.6", "mesh.segments=18",
+                            "mesh.rings=13", "time.end=0.7"});
+  const Problem& p = scene.problem;
+  Simulator sim(p);
+  long long solves = 0, impulses = 0, unresolved = 0;
+  int most = 0, most_step = 0;
+  for (int i = 0; i < sim.num_steps(); ++i) {
+    const StepStats s = sim.step();
+    solves += s.contact.newton_iterations;
+    impulses += s.contact.impulses;
+    unresolved += s.contact.unresolved;
+    if (s.contact.newton_iterations > most) {
+      most = static_cast<int>(s.contact.newton_iterations);
+      most_step = i + 1;
+    }
+  }
+  const SurfaceOperator op = sim.discretization().display(p.collision_level);
+  const long long crossing = check::self_intersections(to_surface(drawn_points(sim, op), op.triangles)).intersecting_pairs;
+  std::printf("crushed sleeve (18 x 13, 60 %% in 0.6 s): %lld Newton solves in %d steps (at most %d, step %d), %lld fail-safe "
+              "impulses, %lld unresolved, %lld crossing pairs of the drawn surface at the end; %.2f s\n",
+              solves, sim.num_steps(), most, most_step, impulses, unresolved, crossing, seconds_since(t0));
+  EXPECT_LE(most, 6) << "at step " << most_step;
+  EXPECT_LE(static_cast<double>(solves), 1.3 * sim.num_steps());
+  EXPECT_EQ(impulses, 0);
+  EXPECT_EQ(unresolved, 0);
+  EXPECT_EQ(crossing, 0);
 }
 
 }  // namespace
