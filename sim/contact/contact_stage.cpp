@@ -1,6 +1,7 @@
 #include "sim/contact/contact_stage.hpp"
 
 #include "sim/contact/barrier.hpp"
+#include "sim/contact/candidates.hpp"
 #include "sim/contact/impact_zones.hpp"
 #include "sim/contact/narrow_phase.hpp"
 #include "sim/contact/obstacle_set.hpp"
@@ -21,6 +22,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -39,8 +41,9 @@ using contact::fit_rigid;
 using contact::Kind;
 using contact::PairGeometry;
 using contact::RigidMap;
+using contact::shares_vertex;
+using contact::swept_box;
 using contact::Zones;
-using RowPoints = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 // y = A X for a row-major sparse A and a dense X with `cols` columns (column-major, X.rows() =
 // A.cols()), rows on all cores; each entry is summed in the row's stored order, as Eigen does.
@@ -81,44 +84,21 @@ struct ContactStage::Impl {
 
   contact::ObstacleSet obs;  // the obstacles' meshes, combined (planes apart)
 
-  contact::BroadPhase self_broad, obstacle_broad;
   // Patches: the fine triangles over one surface triangle of the discretisation (display
-  // triangle i lies over surface triangle i / 4^levels). The broad phase works on patches, then
-  // down a box hierarchy to the fine triangles. Fine triangles of one patch never collide with
-  // each other (one smooth polynomial piece), nor do fine triangles closer than twice the
-  // thickness at rest (near_at_rest): they are neighbours in the material, which the shell keeps
-  // apart by itself, and colliding them would hold the fine surface's neighbours apart when it is
-  // compressed in its plane.
+  // triangle i lies over surface triangle i / 4^levels). The candidate search (the broad phase,
+  // sim/contact/candidates.hpp) works on patches, then down to the fine triangles.
   int fine_per_patch = 1;
   int num_patches = 0;
   std::vector<std::vector<int>> patch_points;      // the fine points of each patch
-  std::vector<std::array<int, 3>> patch_corners;   // the surface triangle under each patch
-  std::vector<std::vector<int>> near_at_rest;      // per fine triangle a: the sorted b > a near it at rest
-  // Per fine triangle a: the sorted b > a that touch it at rest (closer than the near separation)
-  // without being neighbours in the material (their patches share no control vertex): a surface
-  // that meets itself at rest, such as a panel rolled to 359.9999999999°. Such pairs start
-  // colliding and could never be separated, so they make no pairs at all: the cloth is taken to be
-  // joined there (ContactStage::joined_at_rest reports how many).
-  std::vector<std::vector<int>> joined_at_rest;
-  long long joined_pairs = 0;
-  std::vector<std::vector<int>> vertex_patches;    // per control node: the patches that have it as a corner
-  std::vector<std::vector<std::pair<int, int>>> control_edges;  // per control node: (neighbour, edge id)
-  size_t num_control_edges = 0;
-
-  // Scratch of the broad phase, kept for its memory.
-  RowPoints rows0, rows1;
-  std::vector<Box> scratch_point_box;
-  std::vector<std::vector<Box>> scratch_hierarchy;
-  std::vector<Eigen::Vector3d> cone_axis;
-  std::vector<double> cone_angle;
+  long long joined_pairs = 0;  // pairs of fine triangles joined at rest (find_near_at_rest)
+  std::optional<contact::CandidateSearch> search;  // (made last in the constructor)
 
   // Scratch for building constraints: slot per DOF (−1 when unused).
   std::vector<int> slot;
 
   // Per step.
   Eigen::MatrixX3d p0, p1;          // surface points at the start and end of the step
-  std::vector<Box> obstacle_boxes, obstacle_point_box, obstacle_edge_box;  // swept over the step
-  bool obstacle_boxes_current = false;
+  bool obstacle_boxes_current = false;  // the search's obstacle boxes are those of o0 and o1
   Eigen::MatrixX3d o0, o1;          // obstacle vertices at t and t + h
   // No meshed obstacle moves: o0 = o1 and their boxes are the same every step (set at build).
   bool obstacles_static = false;
@@ -146,22 +126,10 @@ struct ContactStage::Impl {
                     owned_points, owned_edges);
     fine_per_patch = 1 << (2 * surface.levels);
     num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
-    if (settings.self) find_near_at_rest();
+    std::vector<std::vector<int>> near_at_rest, joined_at_rest;
+    if (settings.self) find_near_at_rest(near_at_rest, joined_at_rest);
     if (!(settings.flat_region_angle >= 0 && settings.flat_region_angle < 0.5 * M_PI))
       throw std::invalid_argument("collision: the flat-region angle must be >= 0 and < pi/2 [rad]");
-    for (int t = 0; t < num_patches; ++t) patch_corners.push_back(d.control_triangles()[static_cast<size_t>(t)]);
-    vertex_patches.assign(static_cast<size_t>(d.num_nodes()), {});
-    for (int t = 0; t < num_patches; ++t)
-      for (int v : patch_corners[static_cast<size_t>(t)]) vertex_patches[static_cast<size_t>(v)].push_back(t);
-    control_edges.assign(static_cast<size_t>(d.num_nodes()), {});
-    for (const auto& corners : patch_corners)
-      for (int k = 0; k < 3; ++k) {
-        const int u = corners[static_cast<size_t>(k)], w = corners[static_cast<size_t>((k + 1) % 3)];
-        if (control_edge(u, w) >= 0) continue;
-        control_edges[static_cast<size_t>(u)].emplace_back(w, static_cast<int>(num_control_edges));
-        control_edges[static_cast<size_t>(w)].emplace_back(u, static_cast<int>(num_control_edges));
-        ++num_control_edges;
-      }
     patch_points.resize(static_cast<size_t>(num_patches));
     for (int t = 0; t < num_patches; ++t) {
       std::vector<int>& pts = patch_points[static_cast<size_t>(t)];
@@ -174,44 +142,21 @@ struct ContactStage::Impl {
     obs = contact::ObstacleSet(obstacles);
     obstacles_static = std::all_of(obstacles.begin(), obstacles.end(),
                                    [](const Obstacle& o) { return o.shape == Obstacle::Shape::plane || o.motion.empty(); });
+    contact::CandidateSettings search_settings;
+    search_settings.self = settings.self;
+    search_settings.thickness = settings.thickness;
+    search_settings.flat_region_angle = settings.flat_region_angle;
+    search_settings.min_separation_ratio = params.min_separation_ratio;
+    search_settings.near_separation_ratio = params.near_separation_ratio;
+    search.emplace(contact::SearchSurface{surface.triangles, surface.levels, edges, triangle_edges, owned_points, owned_edges,
+                                          d.control_triangles(), d.num_nodes()},
+                   std::move(near_at_rest), std::move(joined_at_rest), obs, search_settings);
   }
 
   // A point–obstacle-triangle pair that adds nothing (contact::ObstacleSet::redundant_on_flat_face).
   bool redundant_on_flat_face_pair(const Candidate& c, const PairGeometry& g, const std::array<Eigen::Vector3d, 4>& x) const {
     return c.kind == Kind::cloth_point_obstacle_triangle &&
            obs.redundant_on_flat_face(c.b, {-g.coef[1], -g.coef[2], -g.coef[3]}, g.normal, x[1], x[2], x[3]);
-  }
-
-  // Obstacle edges and vertices that bend the obstacle's surface little make no pairs with a
-  // cloth triangle (obstacle vertex–cloth triangle) or a cloth edge (cloth edge–obstacle edge)
-  // near them: the cloth points' pairs with the obstacle's triangles keep them clear. A flat
-  // piece of the cloth surface (a fine triangle, its longest edge L) whose corners are at least a
-  // distance s from both triangles of an obstacle edge that bends by θ comes no closer to the
-  // edge than s − (L / 2) tan(θ / 2), where it lies across the edge; with (L / 2) tan(θ / 2) at
-  // most half the CCD's minimum separation η, corners kept η away keep the edge η / 2 away. So on
-  // a finely tessellated smooth obstacle (a capsule at 5°) most of its edges and vertices need no
-  // pairs. smooth_tangent holds, per fine triangle (and per fine edge: the larger of its
-  // triangles'), the largest tan(θ / 2) that allows, with L measured at the start and end of the
-  // step (so it follows stretching).
-  std::vector<double> smooth_tangent_triangle, smooth_tangent_edge;
-  void measure_smooth_tangents() {
-    const double eta = params.min_separation_ratio * settings.thickness;
-    smooth_tangent_triangle.resize(surface.triangles.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, surface.triangles.size(), 4096), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        double longest = 0.0;
-        const auto& t = surface.triangles[i];
-        for (int k = 0; k < 3; ++k) {
-          const int a = t[static_cast<size_t>(k)], b = t[static_cast<size_t>((k + 1) % 3)];
-          longest = std::max({longest, (p0.row(a) - p0.row(b)).squaredNorm(), (p1.row(a) - p1.row(b)).squaredNorm()});
-        }
-        smooth_tangent_triangle[i] = longest > 0 ? eta / std::sqrt(longest) : std::numeric_limits<double>::infinity();
-      }
-    });
-    smooth_tangent_edge.assign(edges.size(), std::numeric_limits<double>::infinity());
-    for (size_t i = 0; i < surface.triangles.size(); ++i)
-      for (int e : triangle_edges[i])
-        smooth_tangent_edge[static_cast<size_t>(e)] = std::min(smooth_tangent_edge[static_cast<size_t>(e)], smooth_tangent_triangle[i]);
   }
 
   // --- Positions -------------------------------------------------------------------------------
@@ -253,19 +198,17 @@ struct ContactStage::Impl {
     return p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
   }
 
-  // --- Broad phase -----------------------------------------------------------------------------
-  static Box swept_box(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b, const std::array<int, 3>& t, double grow) {
-    Box box{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
-            Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity())};
-    for (int v : t) {
-      box.lo = box.lo.cwiseMin(a.row(v).transpose()).cwiseMin(b.row(v).transpose());
-      box.hi = box.hi.cwiseMax(a.row(v).transpose()).cwiseMax(b.row(v).transpose());
-    }
-    box.lo.array() -= grow;
-    box.hi.array() += grow;
-    return box;
+  // --- Broad phase ----------------------------------------------------------------------------
+  // The candidates of the motion p0 → p1 (and the obstacles' o0 → o1) with boxes grown by `grow`
+  // [m] (sim/contact/candidates.hpp); the search keeps the obstacles' boxes until start_positions
+  // moves the obstacles.
+  std::vector<Candidate> candidates(ContactReport& report, double grow) {
+    std::vector<Candidate> out = search->find(p0, p1, o0, o1, obstacle_boxes_current, grow, report);
+    obstacle_boxes_current = true;
+    return out;
   }
 
+  // --- Fine triangles near each other at rest ---------------------------------------------------
   // Distance between two triangles of the collision surface at positions `p` [m].
   double triangle_distance(const Eigen::MatrixX3d& p, const std::array<int, 3>& a, const std::array<int, 3>& b) const {
     double dist = std::numeric_limits<double>::infinity();
@@ -302,7 +245,10 @@ struct ContactStage::Impl {
     return triangle_distance(rest_points, a, b) < near;
   }
 
-  void find_near_at_rest() {
+  // Per fine triangle a: the sorted b > a within twice the thickness of it at rest (near_at_rest),
+  // and those of them that touch it at rest without being neighbours in the material
+  // (joined_at_rest, counted in joined_pairs); sim/contact/candidates.hpp has what they do.
+  void find_near_at_rest(std::vector<std::vector<int>>& near_at_rest, std::vector<std::vector<int>>& joined_at_rest) {
     const double near = 2.0 * settings.thickness;
     near_at_rest.assign(surface.triangles.size(), {});
     std::vector<Box> boxes(surface.triangles.size());
@@ -333,327 +279,6 @@ struct ContactStage::Impl {
       }
     }
     // sorted: the pairs come sorted
-  }
-
-  static bool shares_vertex(const std::array<int, 3>& a, const std::array<int, 3>& b) {
-    for (int x : a)
-      for (int y : b)
-        if (x == y) return true;
-    return false;
-  }
-
-  static bool overlap(const Box& a, const Box& b) {
-    return (a.lo.array() <= b.hi.array()).all() && (b.lo.array() <= a.hi.array()).all();
-  }
-  static Box grown(Box b, double g) {
-    b.lo.array() -= g;
-    b.hi.array() += g;
-    return b;
-  }
-
-  // Flat regions. Over the step a fine triangle's (unnormalised) normal is the quadratic
-  // n(τ) = (1−τ)² n₀ + 2τ(1−τ) n½ + τ² n₁ in the corners' linear motion, a positive combination of
-  // n₀, n½ and n₁; so if all three lie in a cone (axis a, half-angle θ < π/2), so does n(τ) for
-  // the whole step, and n(τ)·a > 0 when n₀, n₁ ≠ 0. Per patch: a cone around the sum of its
-  // triangles' n₀ + n₁ holding every such vector (half-angle π when a triangle is degenerate at
-  // either end); per control vertex: a cone holding the cones of the patches of its star; per
-  // control edge: the smallest cone holding its two end points' cones. A star, or the union of
-  // the two stars of an edge, is flat when that cone's half-angle is below
-  // settings.flat_region_angle.
-  struct FlatRegions {
-    std::vector<char> star;  // per control vertex
-    std::vector<char> edge;  // per control edge (control_edge_ids)
-  };
-  FlatRegions flat_regions(const std::vector<Eigen::Vector3d>& axis, const std::vector<double>& angle) const {
-    FlatRegions flat;
-    flat.star.assign(vertex_patches.size(), 0);
-    flat.edge.assign(num_control_edges, 0);
-    if (!(settings.flat_region_angle > 0)) return flat;
-    std::vector<Eigen::Vector3d> star_axis(vertex_patches.size(), Eigen::Vector3d::Zero());
-    std::vector<double> star_angle(vertex_patches.size(), M_PI);
-    for (size_t v = 0; v < vertex_patches.size(); ++v) {
-      const std::vector<int>& star = vertex_patches[v];
-      Eigen::Vector3d a = Eigen::Vector3d::Zero();
-      bool open = star.empty();
-      for (int q : star) {
-        open = open || angle[static_cast<size_t>(q)] >= settings.flat_region_angle;
-        a += axis[static_cast<size_t>(q)];
-      }
-      const double length = a.norm();
-      if (open || !(length > 0)) continue;
-      a /= length;
-      double theta = 0.0;
-      for (int q : star)
-        theta = std::max(theta, std::acos(std::clamp(a.dot(axis[static_cast<size_t>(q)]), -1.0, 1.0)) + angle[static_cast<size_t>(q)]);
-      star_axis[v] = a;
-      star_angle[v] = theta;
-      flat.star[v] = theta < settings.flat_region_angle;
-    }
-    for (size_t u = 0; u < control_edges.size(); ++u)
-      for (const auto& [w, e] : control_edges[u]) {
-        if (w < static_cast<int>(u) || !flat.star[u] || !flat.star[static_cast<size_t>(w)]) continue;
-        // The smallest cone holding cones (a, α) and (b, β) at an angle φ: the larger one when it
-        // holds the other, else half-angle (φ + α + β) / 2.
-        const double alpha = star_angle[u], beta = star_angle[static_cast<size_t>(w)];
-        const double phi = std::acos(std::clamp(star_axis[u].dot(star_axis[static_cast<size_t>(w)]), -1.0, 1.0));
-        const double theta = phi + std::min(alpha, beta) <= std::max(alpha, beta) ? std::max(alpha, beta) : 0.5 * (phi + alpha + beta);
-        flat.edge[static_cast<size_t>(e)] = theta < settings.flat_region_angle;
-      }
-    return flat;
-  }
-
-  // The cone of patch q's normals over the step (see flat regions): unit axis and half-angle
-  // [rad], π when a triangle is degenerate at either end or a normal is at a right angle or more
-  // to the axis. Reads rows0 and rows1, the surface points at the start and end of the step.
-  std::pair<Eigen::Vector3d, double> patch_cone(int q, std::vector<Eigen::Vector3d>& normals) const {
-    normals.resize(static_cast<size_t>(3 * fine_per_patch));
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    bool degenerate = false;
-    for (int k = 0; k < fine_per_patch; ++k) {
-      const auto& tri = surface.triangles[static_cast<size_t>(q * fine_per_patch + k)];
-      const Eigen::Vector3d a0 = rows0.row(tri[0]), a1 = rows1.row(tri[0]);
-      const Eigen::Vector3d e0 = rows0.row(tri[1]).transpose() - a0, e1 = rows1.row(tri[1]).transpose() - a1;
-      const Eigen::Vector3d f0 = rows0.row(tri[2]).transpose() - a0, f1 = rows1.row(tri[2]).transpose() - a1;
-      Eigen::Vector3d* n = &normals[static_cast<size_t>(3 * k)];
-      n[0] = e0.cross(f0);
-      n[1] = 0.5 * (e0.cross(f1) + e1.cross(f0));
-      n[2] = e1.cross(f1);
-      if (!(n[0].squaredNorm() > 0) || !(n[2].squaredNorm() > 0)) degenerate = true;
-      sum += n[0] + n[2];
-    }
-    const double length = sum.norm();
-    if (degenerate || !(length > 0)) return {Eigen::Vector3d::Zero(), M_PI};
-    sum /= length;
-    // The smallest cos² over the vectors (no square roots); a vector at or beyond a right angle
-    // to the axis opens the cone to π.
-    double min_cos2 = 1.0;
-    for (const Eigen::Vector3d& n : normals) {
-      const double dot = n.dot(sum), norm2 = n.squaredNorm();
-      if (!(norm2 > 0)) continue;
-      if (!(dot > 0)) return {sum, M_PI};
-      min_cos2 = std::min(min_cos2, dot * dot / norm2);
-    }
-    return {sum, std::acos(std::sqrt(std::min(min_cos2, 1.0)))};
-  }
-
-  // The control edge between nodes u and w, or −1.
-  int control_edge(int u, int w) const {
-    for (const auto& [x, e] : control_edges[static_cast<size_t>(u)])
-      if (x == w) return e;
-    return -1;
-  }
-
-  std::vector<Candidate> candidates(ContactReport& report) {
-    const auto t0 = Clock::now();
-    std::vector<Candidate> out;
-    const double grow = candidate_grow > 0 ? candidate_grow : settings.thickness;
-    // Swept boxes: triangles grown by the thickness (for the broad phase), and exact ones of the
-    // triangles, points (grown by the thickness) and edges (grown by half of it) to cull the
-    // pairs a triangle pair stands for.
-    // Swept boxes of the points first (p0 and p1 per point), then of triangles and edges as unions.
-    const Eigen::Index np = p0.rows();
-    rows0 = p0;  // row-major copies: the per-patch pass reads whole points
-    rows1 = p1;
-    std::vector<Box>& point_box = scratch_point_box;
-    point_box.resize(static_cast<size_t>(np));
-    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, np, 4096), [&](const tbb::blocked_range<Eigen::Index>& range) {
-      for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
-        Box& b = point_box[static_cast<size_t>(p)];
-        b.lo = rows0.row(p).cwiseMin(rows1.row(p)).transpose();
-        b.hi = rows0.row(p).cwiseMax(rows1.row(p)).transpose();
-      }
-    });
-    auto unite = [](Box a, const Box& b) {
-      a.lo = a.lo.cwiseMin(b.lo);
-      a.hi = a.hi.cwiseMax(b.hi);
-      return a;
-    };
-    // A box hierarchy over the refinement: level `levels` holds the fine triangles' swept boxes,
-    // level l − 1 the unions of each four children (triangle t of level l − 1 has children
-    // 4t … 4t + 3), level 0 the patches. A patch's subtree is contiguous on every level, so one
-    // pass over the patches builds it, together with the patches' normal cones (self-collision).
-    const int levels = surface.levels;
-    std::vector<std::vector<Box>>& hierarchy = scratch_hierarchy;
-    hierarchy.resize(static_cast<size_t>(levels + 1));
-    for (int l = 0; l <= levels; ++l) hierarchy[static_cast<size_t>(l)].resize(static_cast<size_t>(num_patches) << (2 * l));
-    cone_axis.resize(static_cast<size_t>(num_patches));
-    cone_angle.resize(static_cast<size_t>(num_patches));
-    tbb::parallel_for(tbb::blocked_range<int>(0, num_patches, 256), [&](const tbb::blocked_range<int>& range) {
-      std::vector<Eigen::Vector3d> normals;
-      for (int q = range.begin(); q != range.end(); ++q) {
-        std::vector<Box>& fine = hierarchy[static_cast<size_t>(levels)];
-        for (int t = q * fine_per_patch; t < (q + 1) * fine_per_patch; ++t) {
-          const auto& tri = surface.triangles[static_cast<size_t>(t)];
-          fine[static_cast<size_t>(t)] = unite(unite(point_box[static_cast<size_t>(tri[0])], point_box[static_cast<size_t>(tri[1])]),
-                                               point_box[static_cast<size_t>(tri[2])]);
-        }
-        for (int l = levels; l > 0; --l) {
-          const std::vector<Box>& child = hierarchy[static_cast<size_t>(l)];
-          std::vector<Box>& parent = hierarchy[static_cast<size_t>(l - 1)];
-          const size_t per = size_t{1} << (2 * (l - 1));
-          for (size_t t = static_cast<size_t>(q) * per; t < static_cast<size_t>(q + 1) * per; ++t)
-            parent[t] = unite(unite(child[4 * t], child[4 * t + 1]), unite(child[4 * t + 2], child[4 * t + 3]));
-        }
-        if (settings.self && settings.flat_region_angle > 0)
-          std::tie(cone_axis[static_cast<size_t>(q)], cone_angle[static_cast<size_t>(q)]) = patch_cone(q, normals);
-      }
-    });
-    const std::vector<Box>& tight = hierarchy[static_cast<size_t>(levels)];
-    std::vector<Box> patch_box(static_cast<size_t>(num_patches));
-    for (int q = 0; q < num_patches; ++q) patch_box[static_cast<size_t>(q)] = grown(hierarchy[0][static_cast<size_t>(q)], 0.5 * grow);
-    auto triangle_box = [&](int t) -> const Box& { return tight[static_cast<size_t>(t)]; };
-    auto edge_swept = [&](int e) {  // (computed where needed; read-only, so safe in parallel)
-      const auto& ed = edges[static_cast<size_t>(e)];
-      return grown(unite(point_box[static_cast<size_t>(ed[0])], point_box[static_cast<size_t>(ed[1])]), 0.5 * grow);
-    };
-    std::vector<Box> point_grown(point_box.size());
-    for (size_t p = 0; p < point_box.size(); ++p) point_grown[p] = grown(point_box[p], grow);
-    // Two fine triangles of the cloth from patches that share no vertex: their owned points
-    // against the other triangle, and their owned edges against each other.
-    const double near_growth = params.near_separation_ratio * settings.thickness;
-    auto add_triangle_pair = [&](int i, int j, bool neighbours, std::vector<Candidate>& into) {  // i < j
-      const std::vector<int>& near_i = near_at_rest[static_cast<size_t>(i)];
-      const bool near = neighbours || std::binary_search(near_i.begin(), near_i.end(), j);
-      const std::vector<int>& joined_i = joined_at_rest[static_cast<size_t>(i)];
-      if (near && std::binary_search(joined_i.begin(), joined_i.end(), j)) return;
-      const auto& ti = surface.triangles[static_cast<size_t>(i)];
-      const auto& tj = surface.triangles[static_cast<size_t>(j)];
-      // (Triangles sharing a vertex still make pairs of their other points and edges: a point is
-      // tested through the triangle that owns it, which may be another neighbour.)
-      auto not_in = [](int v, const std::array<int, 3>& t) { return v != t[0] && v != t[1] && v != t[2]; };
-      // Near pairs are only kept from crossing (CCD down to near_separation), so their boxes are
-      // grown by that separation, not by the thickness.
-      const double g_point = near ? near_growth : grow, g_edge = 0.5 * g_point;
-      auto point_reach = [&](int v) { return near ? grown(point_box[static_cast<size_t>(v)], g_point) : point_grown[static_cast<size_t>(v)]; };
-      auto edge_reach = [&](int e) {
-        if (!near) return edge_swept(e);
-        const auto& ed = edges[static_cast<size_t>(e)];
-        return grown(unite(point_box[static_cast<size_t>(ed[0])], point_box[static_cast<size_t>(ed[1])]), g_edge);
-      };
-      if (near && !overlap(grown(triangle_box(i), g_point), triangle_box(j))) return;
-      for (int v : owned_points[static_cast<size_t>(i)])
-        if (not_in(v, tj) && overlap(point_reach(v), triangle_box(j)))
-          into.push_back({Kind::cloth_point_cloth_triangle, v, j, near});
-      for (int v : owned_points[static_cast<size_t>(j)])
-        if (not_in(v, ti) && overlap(point_reach(v), triangle_box(i)))
-          into.push_back({Kind::cloth_point_cloth_triangle, v, i, near});
-      for (int ea : owned_edges[static_cast<size_t>(i)])
-        for (int eb : owned_edges[static_cast<size_t>(j)]) {
-          const auto& e = edges[static_cast<size_t>(ea)];
-          const auto& f = edges[static_cast<size_t>(eb)];
-          if (e[0] == f[0] || e[0] == f[1] || e[1] == f[0] || e[1] == f[1]) continue;
-          if (overlap(edge_reach(ea), edge_reach(eb)))
-            into.push_back({Kind::cloth_edge_cloth_edge, std::min(ea, eb), std::max(ea, eb), near});
-        }
-    };
-    const FlatRegions flat = settings.self ? flat_regions(cone_axis, cone_angle) : FlatRegions{};
-    // Whether patches qa and qb lie in one flat region (the star of a shared vertex, or the two
-    // stars of an edge between them) whose normals stay in a cone narrower than a right angle all
-    // step: then no two points of theirs can meet (docs/contact.md, "Flat regions").
-    auto in_flat_region = [&](int qa, int qb) {
-      const auto& ca = patch_corners[static_cast<size_t>(qa)];
-      const auto& cb = patch_corners[static_cast<size_t>(qb)];
-      for (int x : ca)
-        for (int y : cb) {
-          if (x == y) {
-            if (flat.star[static_cast<size_t>(x)]) return true;
-            continue;
-          }
-          const int e = control_edge(x, y);
-          if (e >= 0 && flat.edge[static_cast<size_t>(e)]) return true;
-        }
-      return false;
-    };
-    // Down the hierarchy from a pair of boxes at level l whose (grown) boxes overlap.
-    struct Node {
-      int level, a, b;
-    };
-    // Patches over surface triangles that share a vertex are neighbours: all their fine pairs are
-    // near pairs (kept from crossing only), and their boxes grow by the near separation.
-    auto descend = [&](int qa, int qb, std::vector<Node>& stack, std::vector<Candidate>& into) {  // depth first, fixed order
-      const bool neighbours = shares_vertex(patch_corners[static_cast<size_t>(qa)], patch_corners[static_cast<size_t>(qb)]);
-      const double g = neighbours ? near_growth : grow;
-      stack.clear();
-      stack.push_back({0, qa, qb});
-      while (!stack.empty()) {
-        const Node n = stack.back();
-        stack.pop_back();
-        const Box& ba = hierarchy[static_cast<size_t>(n.level)][static_cast<size_t>(n.a)];
-        const Box& bb = hierarchy[static_cast<size_t>(n.level)][static_cast<size_t>(n.b)];
-        if (!((ba.lo.array() - g <= bb.hi.array()).all() && (bb.lo.array() <= ba.hi.array() + g).all())) continue;
-        if (n.level == levels) {
-          add_triangle_pair(n.a, n.b, neighbours, into);
-          continue;
-        }
-        for (int i = 4 * n.a + 3; i >= 4 * n.a; --i)
-          for (int j = 4 * n.b + 3; j >= 4 * n.b; --j) stack.push_back({n.level + 1, i, j});
-      }
-    };
-    if (settings.self) {
-      // Patch pairs in fixed chunks on both cores; the chunks' pairs are joined in order, so the
-      // list does not depend on the threads.
-      const std::vector<std::pair<int, int>> pairs =
-          self_broad.self_pairs(patch_box, [&](int qa, int qb) { return !in_flat_region(qa, qb); });
-      constexpr size_t kChunk = 128;
-      std::vector<std::vector<Candidate>> chunks((pairs.size() + kChunk - 1) / kChunk);
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
-        std::vector<Node> stack;
-        for (size_t c = range.begin(); c != range.end(); ++c)
-          for (size_t k = c * kChunk; k < std::min(pairs.size(), (c + 1) * kChunk); ++k)
-            descend(pairs[k].first, pairs[k].second, stack, chunks[c]);
-      });
-      for (const std::vector<Candidate>& chunk : chunks) out.insert(out.end(), chunk.begin(), chunk.end());
-    }
-    if (!obs.triangles.empty()) {
-      if (!obstacle_boxes_current) {  // once per step (once per run for static obstacles)
-        obstacle_boxes.resize(obs.triangles.size());
-        for (size_t t = 0; t < obs.triangles.size(); ++t) obstacle_boxes[t] = swept_box(o0, o1, obs.triangles[t], 0.0);
-        obstacle_point_box.resize(obs.obstacle_of_vertex.size());
-        for (size_t v = 0; v < obstacle_point_box.size(); ++v) {
-          const int i = static_cast<int>(v);
-          obstacle_point_box[v] = swept_box(o0, o1, {i, i, i}, 0.0);
-        }
-        obstacle_edge_box.resize(obs.edges.size());
-        for (size_t e = 0; e < obs.edges.size(); ++e) {
-          const Box& a = obstacle_point_box[static_cast<size_t>(obs.edges[e][0])];
-          const Box& b = obstacle_point_box[static_cast<size_t>(obs.edges[e][1])];
-          obstacle_edge_box[e] = Box{a.lo.cwiseMin(b.lo), a.hi.cwiseMax(b.hi)};  // (grown where used)
-        }
-        obstacle_boxes_current = true;
-      }
-      measure_smooth_tangents();
-      const std::vector<std::pair<int, int>> obroad = obstacle_broad.pairs(patch_box, obstacle_boxes);
-      auto descend_obstacle = [&](int q, int j, std::vector<Candidate>& into) {
-        for (int i = q * fine_per_patch; i < (q + 1) * fine_per_patch; ++i) {
-          if (!overlap(grown(triangle_box(i), grow), obstacle_boxes[static_cast<size_t>(j)])) continue;
-          for (int v : owned_points[static_cast<size_t>(i)])
-            if (overlap(point_grown[static_cast<size_t>(v)], obstacle_boxes[static_cast<size_t>(j)]))
-              into.push_back({Kind::cloth_point_obstacle_triangle, v, j});
-          for (int v : obs.owned_points[static_cast<size_t>(j)])
-            if (obs.vertex_tangent[static_cast<size_t>(v)] > smooth_tangent_triangle[static_cast<size_t>(i)] &&
-                overlap(grown(obstacle_point_box[static_cast<size_t>(v)], grow), triangle_box(i)))
-              into.push_back({Kind::obstacle_point_cloth_triangle, v, i});
-          for (int ea : owned_edges[static_cast<size_t>(i)])
-            for (int eb : obs.owned_edges[static_cast<size_t>(j)])
-              if (obs.edge_tangent[static_cast<size_t>(eb)] > smooth_tangent_edge[static_cast<size_t>(ea)] &&
-                  overlap(edge_swept(ea), grown(obstacle_edge_box[static_cast<size_t>(eb)], 0.5 * grow)))
-                into.push_back({Kind::cloth_edge_obstacle_edge, ea, eb});
-        }
-      };
-      // (In fixed chunks on both cores, joined in order, as the self pairs.)
-      constexpr size_t kChunk = 256;
-      std::vector<std::vector<Candidate>> chunks((obroad.size() + kChunk - 1) / kChunk);
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
-        for (size_t c = range.begin(); c != range.end(); ++c)
-          for (size_t k = c * kChunk; k < std::min(obroad.size(), (c + 1) * kChunk); ++k)
-            descend_obstacle(obroad[k].first, obroad[k].second, chunks[c]);
-      });
-      for (const std::vector<Candidate>& chunk : chunks) out.insert(out.end(), chunk.begin(), chunk.end());
-    }
-    // Every pair is made once (ownership) in an order fixed by the sorted broad-phase pairs, so
-    // the list is deterministic without sorting.
-    report.broad_ms += ms_since(t0);
-    return out;
   }
 
   // --- Pair geometry ---------------------------------------------------------------------------
@@ -1306,7 +931,6 @@ struct ContactStage::Impl {
   // --- The potential inside the step (docs/contact.md, "Contact inside the step") ---------------
   bool potential_on = false;
   double potential_t = 0.0;
-  double candidate_grow = 0.0;              // > 0: the broad phase's growth instead of the thickness [m]
   std::vector<Candidate> potential_cands;   // this step's candidates (boxes grown by 2 d̂)
   Eigen::MatrixX3d potential_guess;         // the end points they were made for
   std::vector<double> plane_stiffness;      // per surface point, against planes [N/m]
@@ -1482,10 +1106,8 @@ struct ContactStage::Impl {
   void make_potential_candidates(ContactReport& report) {
     lin_bounds_valid = false;
     served_known = false;
-    candidate_grow = settings.thickness + 2.0 * serve_radius();
-    potential_cands = candidates(report);
+    potential_cands = candidates(report, settings.thickness + 2.0 * serve_radius());
     near_reach_of.assign(potential_cands.size(), -1.0);
-    candidate_grow = 0.0;
     potential_guess = p1;
     built_p0 = p0;
     built_o0 = o0;
@@ -1911,17 +1533,8 @@ struct ContactStage::Impl {
     const std::vector<Candidate>* cands = &potential_cands;
     std::vector<Candidate> own;
     if (!(served(from, pa) && served(to, pb))) {
-      const Eigen::MatrixX3d start_points = p0, end_points = p1;
-      const bool boxes = obstacle_boxes_current;
-      p0 = pa;
-      p1 = pb;
-      candidate_grow = settings.thickness;
       ContactReport scratch;
-      own = candidates(scratch);
-      candidate_grow = 0.0;
-      p0 = start_points;
-      p1 = end_points;
-      obstacle_boxes_current = boxes;
+      own = search->find(pa, pb, o0, o1, obstacle_boxes_current, settings.thickness, scratch);
       cands = &own;
     }
     // The obstacles stand where they are at the end of the step at both ends of the move.
@@ -2044,7 +1657,6 @@ struct ContactStage::Impl {
     auto t0 = Clock::now();
     system_diagonal = sys.matrix.diagonal();
     const Eigen::VectorXd base = v;  // the solve's velocities, v*
-    candidate_grow = 0.0;
     if (potential_on && potential_step_start == std::pair{t, step} && x.size() == potential_x.size() && x == potential_x) {
       // The potential's start positions of this step; its last end points when they are of v.
       end_points_current = v.size() == p1_velocity.size() && v == p1_velocity;
@@ -2074,11 +1686,10 @@ struct ContactStage::Impl {
         cands = &potential_cands;  // (read in place, not copied)
         use_bounds = true;
       } else {
-        candidate_grow = 0.0;
-        own = candidates(report), cands = &own;
+        own = candidates(report, settings.thickness), cands = &own;
       }
     } else {
-      own = candidates(report), cands = &own;
+      own = candidates(report, settings.thickness), cands = &own;
       constraints = proximity(*cands, t, report);
       warm_start(constraints);
       report.proximity_pairs = static_cast<int>(constraints.size());
@@ -2099,7 +1710,7 @@ struct ContactStage::Impl {
       const bool changed = !end_points_current;  // impulses since the candidates were made
       update_end_points(v);
       report.narrow_ms += ms_since(t0);
-      if (!cands_current || changed) own = candidates(report), cands = &own;
+      if (!cands_current || changed) own = candidates(report, settings.thickness), cands = &own;
       cands_current = false;  // the response below moves the end points
       if (pass == 0 && use_bounds) {
         double obstacle_motion = 0.0, motion = 0.0;
@@ -2132,7 +1743,7 @@ struct ContactStage::Impl {
       update_end_points(v);
       report.narrow_ms += ms_since(t0);
       if (round > 0) {
-        own = candidates(report), cands = &own;
+        own = candidates(report, settings.thickness), cands = &own;
         hits = collisions(*cands, t, report);
         if (hits.empty()) return report;
       }
@@ -2155,7 +1766,7 @@ struct ContactStage::Impl {
       move_zones(zones, zone_obstacle, x, t, v, report);
     }
     update_end_points(v);
-    report.unresolved = static_cast<int>(collisions(candidates(report), t, report).size());
+    report.unresolved = static_cast<int>(collisions(candidates(report, settings.thickness), t, report).size());
     return report;
   }
 };
