@@ -15,7 +15,8 @@
 // Per step:
 //  1. broad phase: the boxes of the surface triangles swept over the step and grown by the
 //     thickness, against each other (self-collision) and against the obstacles' swept triangles
-//     (Embree, sim/contact/broad_phase.hpp); candidate point–triangle and edge–edge pairs;
+//     (sim/contact/candidates.hpp, with Embree: sim/contact/broad_phase.hpp); candidate
+//     point–triangle and edge–edge pairs;
 //  2. proximity: pairs closer than the thickness at the start of the step get inelastic impulses
 //     that stop their approach, a repulsion of at most 10 % of the overlap per step, and Coulomb
 //     friction bounded by μ times the normal impulse;
