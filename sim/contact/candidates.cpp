@@ -397,7 +397,12 @@ std::vector<Candidate> CandidateSearch::find(const Eigen::MatrixX3d& p0, const E
       }
     }
     measure_smooth_tangents(p0, p1);
-    const std::vector<std::pair<int, int>> obroad = obstacle_broad_.pairs(patch_box, obstacle_boxes_);
+    // (The patches reach the obstacles, whose boxes are not grown, by all of `grow`, as the fine
+    // triangles do below. Before 2026-11-28 they reached half as far: the barrier's candidates,
+    // made to serve moves of half the thickness, then reached obstacles only one thickness away.)
+    std::vector<Box> patch_reach(patch_box.size());
+    for (int q = 0; q < num_patches; ++q) patch_reach[static_cast<size_t>(q)] = grown(hierarchy[0][static_cast<size_t>(q)], grow);
+    const std::vector<std::pair<int, int>> obroad = obstacle_broad_.pairs(patch_reach, obstacle_boxes_);
     auto descend_obstacle = [&](int q, int j, std::vector<Candidate>& into) {
       for (int i = q * fine_per_patch; i < (q + 1) * fine_per_patch; ++i) {
         if (!overlap(grown(triangle_box(i), grow), obstacle_boxes_[static_cast<size_t>(j)])) continue;

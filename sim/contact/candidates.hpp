@@ -86,10 +86,8 @@ class CandidateSearch {
   //    near separation instead, and the pair is marked `near`; fine triangles joined at rest, a
   //    point with a triangle that has it as a corner and edges with an end in common make no
   //    pairs; nor do patches in one flat region;
-  //  - obstacles: patches whose swept boxes grown by half of `grow` overlap an obstacle
-  //    triangle's swept box, which is not grown (so against the obstacles the patches reach half
-  //    as far as against each other), then the patch's fine triangles whose boxes grown by `grow`
-  //    overlap it: their owned points with the obstacle triangle and the obstacle vertices it
+  //  - obstacles: patches whose swept boxes grown by `grow` overlap an obstacle triangle's swept
+  //    box (not grown), then the patch's fine triangles whose boxes grown by `grow` overlap it: their owned points with the obstacle triangle and the obstacle vertices it
   //    owns with the fine triangle (points grown by `grow`), and their owned edges with its owned
   //    edges (each grown by half of `grow`), less the obstacle edges and vertices that bend the
   //    obstacle too little for the fine triangle (or edge) at hand.
