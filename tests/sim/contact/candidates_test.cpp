@@ -419,6 +419,38 @@ TEST(CandidateSearch, PointMovingIntoAnObstacleTriangleIsFound) {
   std::printf("%zu pairs, %d top-face triangles under the point\n", moving.size(), under);
 }
 
+TEST(CandidateSearch, ObstaclesAreReachedByTheWholeGrowth) {
+  // A sheet resting still over the box's top face at 0.9 × the growth (static obstacle): every
+  // point is within the growth of the face below it, so each makes a pair with a top-face
+  // triangle; at 1.1 × the growth there is none. (Before the fix the patches reached the
+  // obstacles by half the growth: 0 pairs from 0.55 thicknesses on.)
+  std::vector<Obstacle> obstacles = {box_obstacle()};
+  const ObstacleSet obs(obstacles);
+  const Eigen::MatrixX3d o = obstacles[0].mesh.vertices;
+  CandidateSettings s;
+  s.thickness = kThickness;
+  for (const double grow : {kThickness, 2.0 * kThickness}) {
+    for (const double factor : {0.9, 1.1}) {
+      TriMesh sheet = make_grid(0.01, 0.01, 2, 2);
+      sheet.vertices.col(2).array() += 0.01 + factor * grow;
+      const Cloth c(sheet, 1);
+      CandidateSearch search(c.surface(), {}, {}, obs, s);
+      ContactCounters report;
+      const std::vector<Candidate> found = search.find(c.rest, c.rest, o, o, false, grow, report);
+      std::set<int> points;
+      for (const Candidate& k : found)
+        if (k.kind == Kind::cloth_point_obstacle_triangle) points.insert(k.a);
+      std::printf("sheet %.1f x growth %.1e m above the face: %zu pairs, %zu of %td points paired\n", factor, grow, found.size(),
+                  points.size(), c.rest.rows());
+      if (factor < 1.0) {
+        EXPECT_EQ(static_cast<Eigen::Index>(points.size()), c.rest.rows()) << "growth " << grow;
+      } else {
+        EXPECT_TRUE(found.empty()) << "growth " << grow;
+      }
+    }
+  }
+}
+
 TEST(CandidateSearch, SameListInTheSameOrderEveryTime) {
   std::vector<Obstacle> obstacles = {box_obstacle()};
   const ObstacleSet obs(obstacles);
