@@ -123,7 +123,7 @@ void CandidateSearch::measure_smooth_tangents(const Eigen::MatrixX3d& p0, const 
 // settings.flat_region_angle.
 struct CandidateSearch::FlatRegions {
   std::vector<char> star;  // per control vertex
-  std::vector<char> edge;  // per control edge (control_edge_ids)
+  std::vector<char> edge;  // per control edge (numbered as control_edge() finds them)
 };
 
 CandidateSearch::FlatRegions CandidateSearch::flat_regions(const std::vector<Eigen::Vector3d>& axis,

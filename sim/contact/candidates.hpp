@@ -152,8 +152,8 @@ class CandidateSearch {
   // edge than s − (L / 2) tan(θ / 2), where it lies across the edge; with (L / 2) tan(θ / 2) at
   // most half the CCD's minimum separation η, corners kept η away keep the edge η / 2 away. So on
   // a finely tessellated smooth obstacle (a capsule at 5°) most of its edges and vertices need no
-  // pairs. smooth_tangent holds, per fine triangle (and per fine edge: the larger of its
-  // triangles'), the largest tan(θ / 2) that allows, with L measured at the start and end of the
+  // pairs. smooth_tangent holds, per fine triangle (and per fine edge: the smaller of its
+  // triangles', i.e. that of the larger triangle), the largest tan(θ / 2) that allows, with L measured at the start and end of the
   // step (so it follows stretching).
   std::vector<double> smooth_tangent_triangle_, smooth_tangent_edge_;
 };

@@ -89,7 +89,6 @@ struct ContactStage::Impl {
   // sim/contact/candidates.hpp) works on patches, then down to the fine triangles.
   int fine_per_patch = 1;
   int num_patches = 0;
-  std::vector<std::vector<int>> patch_points;      // the fine points of each patch
   long long joined_pairs = 0;  // pairs of fine triangles joined at rest (find_near_at_rest)
   std::optional<contact::CandidateSearch> search;  // (made last in the constructor)
 
@@ -130,14 +129,6 @@ struct ContactStage::Impl {
     if (settings.self) find_near_at_rest(near_at_rest, joined_at_rest);
     if (!(settings.flat_region_angle >= 0 && settings.flat_region_angle < 0.5 * M_PI))
       throw std::invalid_argument("collision: the flat-region angle must be >= 0 and < pi/2 [rad]");
-    patch_points.resize(static_cast<size_t>(num_patches));
-    for (int t = 0; t < num_patches; ++t) {
-      std::vector<int>& pts = patch_points[static_cast<size_t>(t)];
-      for (int k = 0; k < fine_per_patch; ++k)
-        for (int v : surface.triangles[static_cast<size_t>(t * fine_per_patch + k)]) pts.push_back(v);
-      std::sort(pts.begin(), pts.end());
-      pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-    }
 
     obs = contact::ObstacleSet(obstacles);
     obstacles_static = std::all_of(obstacles.begin(), obstacles.end(),
