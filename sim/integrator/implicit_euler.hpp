@@ -34,6 +34,8 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace clothsim {
@@ -252,6 +254,16 @@ class ImplicitEuler {
   void end_positions(const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd& target,
                      Eigen::VectorXd& x_end, Eigen::VectorXd& u_end) const;
   bool potential_acted_ = false;  // the step potential was something in this step's Newton iterates
+  // Scratch of solve_with_potential: the linearisation's blocks merged by row (first occurrence
+  // order), weighted by the integrator's h² or h.
+  struct RowHash {
+    size_t operator()(const NodeRow* r) const;
+  };
+  struct RowEqual {
+    bool operator()(const NodeRow* a, const NodeRow* b) const { return a->nodes == b->nodes && a->dofs == b->dofs; }
+  };
+  std::vector<std::pair<const NodeRow*, Eigen::Matrix3d>> merged_;
+  std::unordered_map<const NodeRow*, size_t, RowHash, RowEqual> merged_index_;
   bool contact_last_step_ = false;  // ... in the last step's (the next step's Newton starts from v)
 };
 
