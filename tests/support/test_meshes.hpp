@@ -1,6 +1,6 @@
 // Small meshes built for tests: a regular triangular lattice, a "fan disc" whose centre has any
 // valence, with every other interior vertex regular, and a grid with jittered interior vertices;
-// and the area of a mesh.
+// the area of a mesh; and two meshes as one.
 #pragma once
 
 #include "sim/mesh/generators.hpp"
@@ -86,6 +86,16 @@ inline double mesh_area(const TriMesh& m) {
   for (const Triangle& t : m.triangles)
     area += 0.5 * (m.vertices.row(t[1]) - m.vertices.row(t[0])).cross(m.vertices.row(t[2]) - m.vertices.row(t[0])).norm();
   return area;
+}
+
+// `a` and `b` as one mesh of two parts: b's vertices follow a's, its triangles renumbered.
+inline TriMesh concatenated(const TriMesh& a, const TriMesh& b) {
+  TriMesh m;
+  m.vertices.resize(a.vertices.rows() + b.vertices.rows(), 3);
+  m.vertices << a.vertices, b.vertices;
+  m.triangles = a.triangles;
+  for (const Triangle& t : b.triangles) m.triangles.push_back({t[0] + a.num_vertices(), t[1] + a.num_vertices(), t[2] + a.num_vertices()});
+  return m;
 }
 
 }  // namespace clothsim::testing

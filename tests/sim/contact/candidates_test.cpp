@@ -7,6 +7,7 @@
 // pairs across the crease; and the list is the same, in the same order, every time.
 //
 // Conventions: grids lie in z = 0 (sim/mesh/generators.hpp), the thickness is 1 mm; lengths [m].
+#include "tests/support/test_meshes.hpp"
 #include "sim/contact/candidates.hpp"
 
 #include "sim/contact/narrow_phase.hpp"
@@ -68,22 +69,13 @@ struct Cloth {
   }
 };
 
-TriMesh concatenated(const TriMesh& a, const TriMesh& b) {
-  TriMesh m;
-  m.vertices.resize(a.vertices.rows() + b.vertices.rows(), 3);
-  m.vertices << a.vertices, b.vertices;
-  m.triangles = a.triangles;
-  for (const Triangle& t : b.triangles) m.triangles.push_back({t[0] + a.num_vertices(), t[1] + a.num_vertices(), t[2] + a.num_vertices()});
-  return m;
-}
-
 // Two 1 cm squares of 2 × 2 cells, the second `gap` above the first and shifted a little.
 TriMesh two_sheets(double gap = 1.2e-3) {
   TriMesh lower = make_grid(0.01, 0.01, 2, 2);
   TriMesh upper = make_grid(0.01, 0.01, 2, 2);
   upper.vertices.col(0).array() += 0.0013;
   upper.vertices.col(2).array() += gap;
-  return concatenated(lower, upper);
+  return testing::concatenated(lower, upper);
 }
 
 CandidateSettings self_settings(double flat_region_angle) {

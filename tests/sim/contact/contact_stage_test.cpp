@@ -12,6 +12,7 @@
 // Conventions: grids lie in z = 0 (sim/mesh/generators.hpp); gravity is along −z and the ground
 // is the plane z = 0 with normal +z unless a test tilts it. Lengths [m], times [s], energies [J].
 // Each test prints the figures it measured.
+#include "tests/support/test_meshes.hpp"
 #include "sim/contact/obstacle.hpp"
 #include "sim/shell/material_presets.hpp"
 #include "sim/dynamics/simulator.hpp"
@@ -95,15 +96,6 @@ TriMesh transformed(TriMesh mesh, const Eigen::Matrix3d& r, const Eigen::Vector3
   for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
     mesh.vertices.row(v) = (r * mesh.vertices.row(v).transpose() + c).transpose();
   return mesh;
-}
-
-TriMesh concatenated(const TriMesh& a, const TriMesh& b) {
-  TriMesh m;
-  m.vertices.resize(a.vertices.rows() + b.vertices.rows(), 3);
-  m.vertices << a.vertices, b.vertices;
-  m.triangles = a.triangles;
-  for (const Triangle& t : b.triangles) m.triangles.push_back({t[0] + a.num_vertices(), t[1] + a.num_vertices(), t[2] + a.num_vertices()});
-  return m;
 }
 
 check::Surface to_surface(const Eigen::MatrixX3d& points, const std::vector<Triangle>& triangles) {
@@ -621,7 +613,7 @@ CollisionRun collide_patches() {
   const TriMesh a = transformed(make_grid(0.06, 0.06, 6, 6), Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 0.01));
   const Eigen::Matrix3d tilt = Eigen::AngleAxisd(15.0 * kPi / 180.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
   const TriMesh b = transformed(make_grid(0.06, 0.06, 6, 6), tilt, Eigen::Vector3d(0.01, 0, -0.01));
-  Problem p = cloth_problem(concatenated(a, b), 1e-3, 0.1);
+  Problem p = cloth_problem(testing::concatenated(a, b), 1e-3, 0.1);
   p.collision.self = true;
   p.collision.friction = 0.3;
   p.initial.velocity = Eigen::Vector3d(0.3, 0.1, 0.0);
