@@ -256,14 +256,19 @@ class ImplicitEuler {
   bool potential_acted_ = false;  // the step potential was something in this step's Newton iterates
   // Scratch of solve_with_potential: the linearisation's blocks merged by row (first occurrence
   // order), weighted by the integrator's h² or h.
+  // (Blocks are keyed by their row, in node form or on points.)
+  using Block = PotentialLinearisation::Block;
   struct RowHash {
-    size_t operator()(const NodeRow* r) const;
+    size_t operator()(const Block* b) const;
   };
   struct RowEqual {
-    bool operator()(const NodeRow* a, const NodeRow* b) const { return a->nodes == b->nodes && a->dofs == b->dofs; }
+    bool operator()(const Block* a, const Block* b) const {
+      if (a->is_on_points() || b->is_on_points()) return a->on_points == b->on_points;
+      return a->row.nodes == b->row.nodes && a->row.dofs == b->row.dofs;
+    }
   };
-  std::vector<std::pair<const NodeRow*, Eigen::Matrix3d>> merged_;
-  std::unordered_map<const NodeRow*, size_t, RowHash, RowEqual> merged_index_;
+  std::vector<std::pair<const Block*, Eigen::Matrix3d>> merged_;
+  std::unordered_map<const Block*, size_t, RowHash, RowEqual> merged_index_;
   bool contact_last_step_ = false;  // ... in the last step's (the next step's Newton starts from v)
 };
 

@@ -15,6 +15,37 @@ std::vector<int> NodeRow::node_list() const {
   return out;
 }
 
+int PointRow::entries(const PointMap& map) const {
+  int n = 0;
+  for (int k = 0; k < count; ++k) {
+    const size_t p = static_cast<size_t>(points[static_cast<size_t>(k)]);
+    n += map.offsets[p + 1] - map.offsets[p];
+  }
+  return n;
+}
+
+NodeRow PointRow::node_row(const PointMap& map) const {
+  NodeRow row;
+  row.nodes.reserve(static_cast<size_t>(entries(map)));
+  for (int k = 0; k < count; ++k) {
+    const size_t p = static_cast<size_t>(points[static_cast<size_t>(k)]);
+    const double c = coefs[static_cast<size_t>(k)];
+    for (int e = map.offsets[p]; e < map.offsets[p + 1]; ++e)
+      row.nodes.emplace_back(map.nodes[static_cast<size_t>(e)], c * map.weights[static_cast<size_t>(e)]);
+  }
+  std::stable_sort(row.nodes.begin(), row.nodes.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  size_t out = 0;
+  for (size_t i = 0; i < row.nodes.size(); ++i) {
+    if (out > 0 && row.nodes[out - 1].first == row.nodes[i].first) {
+      row.nodes[out - 1].second += row.nodes[i].second;
+    } else {
+      row.nodes[out++] = row.nodes[i];
+    }
+  }
+  row.nodes.resize(out);
+  return row;
+}
+
 bool CoupledMatrix::covers(const Eigen::SparseMatrix<double>& a, const std::vector<std::vector<int>>& groups) const {
   if (matrix_.rows() != a.rows() || a_entries_ != a.nonZeros()) return false;
   for (const std::vector<int>& nodes : groups)

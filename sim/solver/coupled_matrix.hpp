@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <array>
 #include <utility>
 #include <vector>
 
@@ -37,6 +38,55 @@ struct NodeRow {
   }
   // The nodes the row touches, sorted and unique.
   std::vector<int> node_list() const;
+};
+
+// Points that are a linear map of the nodes, p_i = Σ_j w_ij x_j (+ a constant): per point its
+// nodes and weights, packed (a collision surface's J in node form).
+struct PointMap {
+  std::vector<int> offsets{0};  // #points + 1: point i's entries are [offsets[i], offsets[i + 1])
+  std::vector<int> nodes;
+  std::vector<double> weights;
+  int num_points() const { return static_cast<int>(offsets.size()) - 1; }
+};
+
+// A row on up to four points of a PointMap, u = Σ_k c_k p_k: a contact pair's relative position
+// or velocity (a point against an obstacle: one point). Its node form is Σ_k c_k Σ_j w_kj x_j,
+// over the union of the points' nodes (12–50 on a level-2 Loop surface), which applying the row
+// on the points avoids building.
+struct PointRow {
+  std::array<int, 4> points{};
+  std::array<double, 4> coefs{};
+  int count = 0;
+
+  Eigen::Vector3d apply(const PointMap& map, const Eigen::VectorXd& x) const {  // u = B x
+    Eigen::Vector3d u = Eigen::Vector3d::Zero();
+    for (int k = 0; k < count; ++k) {
+      const int p = points[static_cast<size_t>(k)];
+      const double c = coefs[static_cast<size_t>(k)];
+      for (int e = map.offsets[static_cast<size_t>(p)]; e < map.offsets[static_cast<size_t>(p) + 1]; ++e)
+        u += (c * map.weights[static_cast<size_t>(e)]) * x.segment<3>(3 * map.nodes[static_cast<size_t>(e)]);
+    }
+    return u;
+  }
+  void scatter(const PointMap& map, const Eigen::Vector3d& force, Eigen::VectorXd& y) const {  // y += Bᵀ force
+    for (int k = 0; k < count; ++k) {
+      const int p = points[static_cast<size_t>(k)];
+      const double c = coefs[static_cast<size_t>(k)];
+      for (int e = map.offsets[static_cast<size_t>(p)]; e < map.offsets[static_cast<size_t>(p) + 1]; ++e)
+        y.segment<3>(3 * map.nodes[static_cast<size_t>(e)]) += (c * map.weights[static_cast<size_t>(e)]) * force;
+    }
+  }
+  // Entries of its node form before merging (the cost of apply or scatter).
+  int entries(const PointMap& map) const;
+  // The node form, nodes sorted and merged.
+  NodeRow node_row(const PointMap& map) const;
+  bool operator==(const PointRow& o) const {
+    if (count != o.count) return false;
+    for (int k = 0; k < count; ++k)
+      if (points[static_cast<size_t>(k)] != o.points[static_cast<size_t>(k)] || coefs[static_cast<size_t>(k)] != o.coefs[static_cast<size_t>(k)])
+        return false;
+    return true;
+  }
 };
 
 class CoupledMatrix {

@@ -75,6 +75,29 @@ struct LinearSolver::Impl {
   double iterations_since_factor = 0.0;
   bool refactor_next = false;
   Eigen::VectorXd factored_values;  // of the matrix last factorised for the preconditioner (checkpoints)
+  // A new preconditioner factor of a (the pattern adopted), counted in `report`.
+  void factorize(const Eigen::SparseMatrix<double>& a, const std::vector<char>& free, LinearSolveReport& report) {
+    const auto f0 = std::chrono::steady_clock::now();
+    factor->factorize(a, &free);  // of the Dirichlet form
+    factored_values = Eigen::Map<const Eigen::VectorXd>(a.valuePtr(), a.nonZeros());
+    ++report.factorizations;
+    report.factor_ms += ms_since(f0);
+    solves_since_factor = 0;
+    iterations_since_factor = 0.0;
+  }
+  // The report of a conjugate-gradient solve r.
+  static void finish(const PcgResult& r, const LinearSolverSettings& s, LinearSolveReport& report) {
+    report.iterations += r.iterations;
+    report.residual = r.residual;
+    report.converged = r.converged;
+    if (!r.converged) {
+      std::ostringstream text;
+      text << "the conjugate gradient solver did not converge: relative residual " << r.residual << " after "
+           << r.iterations << " iterations (tolerance " << s.tolerance
+           << "); try a smaller time step, more iterations or \"solver\": {\"type\": \"cholmod\"}";
+      report.failure = text.str();
+    }
+  }
   explicit Impl(bool supernodal_factor)
       : direct(std::make_unique<DirectSolver>(supernodal_factor)),
         factor(std::make_unique<CholeskyPreconditioner>()),
@@ -93,16 +116,6 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
   LinearSolveReport report;
   if (!a.isCompressed()) throw std::invalid_argument("LinearSolver::solve: the matrix must be compressed");
   if (m.adopt_pattern(a)) m.refactor_next = false;  // (a new factor is made below)
-  auto refactor = [&] {
-    const auto f0 = std::chrono::steady_clock::now();
-    m.factor->factorize(a, &free);  // of the Dirichlet form
-    m.factored_values = Eigen::Map<const Eigen::VectorXd>(a.valuePtr(), a.nonZeros());
-    ++report.factorizations;
-    report.factor_ms += ms_since(f0);
-    m.solves_since_factor = 0;
-    m.iterations_since_factor = 0.0;
-  };
-
   if (s.type == LinearSolverType::cholmod) {
     // Dirichlet form: constrained columns moved to the right-hand side, unit diagonal in their
     // rows and columns.
@@ -128,58 +141,88 @@ LinearSolveReport LinearSolver::solve(Eigen::SparseMatrix<double>& a, Eigen::Vec
     return report;
   }
 
-  const bool cholesky = s.preconditioner == PreconditionerType::cholesky;
-  if (cholesky && (!m.factor->ready() || m.refactor_next)) {
-    m.refactor_next = false;
-    refactor();
+  if (s.preconditioner != PreconditionerType::cholesky) {
+    const PcgResult r = solve_pcg(a, b, free, x, s.tolerance, s.max_iterations);
+    m.finish(r, s, report);
+    return report;
   }
-  const Preconditioner factor = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor->apply(r, z); };
+  return pcg_with_factor(
+      [&](int limit, const Preconditioner& factor) { return solve_pcg(a, b, free, x, s.tolerance, limit, factor); },
+      [&](LinearSolveReport& r) { m.factorize(a, free, r); }, static_cast<double>(a.nonZeros()), x);
+}
+
+bool LinearSolver::solves_operators() const {
+  return settings_.type == LinearSolverType::pcg && settings_.preconditioner == PreconditionerType::cholesky;
+}
+
+LinearSolveReport LinearSolver::solve(const LinearOperator& product, double product_entries, const MatrixSource& assemble,
+                                      const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x) {
+  if (!solves_operators())
+    throw std::logic_error("LinearSolver::solve: a matrix given as an operation needs pcg with the cholesky preconditioner");
+  Impl& m = *impl_;
+  const Eigen::SparseMatrix<double>* assembled = nullptr;
+  auto refactor = [&](LinearSolveReport& r) {
+    Eigen::SparseMatrix<double>& a = assemble();
+    if (!a.isCompressed()) throw std::invalid_argument("LinearSolver::solve: the matrix must be compressed");
+    m.adopt_pattern(a);
+    m.factorize(a, free, r);
+    assembled = &a;
+  };
+  auto pcg = [&](int limit, const Preconditioner& factor) {
+    if (factor) return solve_pcg(product, b, free, x, settings_.tolerance, limit, factor);
+    // (no factor: its factorisation, just made, failed; block Jacobi of the matrix it was of)
+    if (assembled == nullptr) throw std::logic_error("LinearSolver::solve: no factor and no matrix");
+    return solve_pcg(product, b, free, x, settings_.tolerance, limit, block_jacobi(*assembled, free));
+  };
+  return pcg_with_factor(pcg, refactor, product_entries, x);
+}
+
+LinearSolveReport LinearSolver::pcg_with_factor(const std::function<PcgResult(int, const Preconditioner&)>& pcg,
+                                                const std::function<void(LinearSolveReport&)>& refactor, double entries,
+                                                Eigen::VectorXd& x) {
+  Impl& m = *impl_;
+  const LinearSolverSettings& s = settings_;
+  LinearSolveReport report;
+  if (!m.factor->ready() || m.refactor_next) {
+    m.refactor_next = false;
+    refactor(report);
+  }
+  const Preconditioner factor = [&m](const Eigen::VectorXd& r, Eigen::VectorXd& z) { m.factor->apply(r, z); };
   const Eigen::VectorXd start = x;
   // With a stale factor a solve is cut off after 3 × refresh_iterations (a fresh factor is cheaper
   // than that) and, below, refactorised and solved again.
-  const int first_limit = cholesky && m.factor->ready() ? std::min(s.max_iterations, 3 * s.refresh_iterations) : s.max_iterations;
-  PcgResult r = solve_pcg(a, b, free, x, s.tolerance, first_limit, cholesky && m.factor->ready() ? factor : Preconditioner());
-  if (cholesky) {
-    // The factor is of an earlier matrix, and the iterations grow as the matrix drifts from it
-    // (about one more per step in the buckling sleeve). Refactor when this solve cost more than
-    // the average per solve since the last factorisation, the factorisation included (for a cost
-    // that grows steadily this minimises the long-run average), or when it exceeded
-    // refresh_iterations. The new factor is of the next step's matrix (taken at the start of that
-    // step), not of this one, which is solved already: a factor of the matrix being solved needs
-    // 3–4 iterations (half-precision solves), one a step old 5–6 in the sleeve's slow phases and
-    // 9–60 while it snaps into folds. The factorisation's cost in iterations is estimated from its
-    // flop count against the flops of one iteration (two triangular solves and a product with A),
-    // scaled by 0.17, fitted on the 2542-vertex sleeve (2 cores): first with single-precision
-    // solves (factorisation 22 ms ≙ 21 iterations of 1.05 ms), checked again with half-precision
-    // solves (21.5 ms, 0.75 ms per iteration). The optimum is flat: 0.12 / 0.17 / 0.25 / 0.35 /
-    // 0.5 model to 11.4 / 11.3 / 11.7 / 12.0 / 12.5 ms of solve per step (docs/performance.md).
-    // Decided on counts, never on timings: runs are repeatable.
-    ++m.solves_since_factor;
-    m.iterations_since_factor += r.iterations;
-    const double iteration_work = 4.0 * static_cast<double>(m.factor->factor_entries()) + 2.0 * static_cast<double>(a.nonZeros());
-    const double factor_cost = 0.17 * m.factor->factor_flops() / std::max(iteration_work, 1.0);
-    const bool pays = r.iterations * m.solves_since_factor > factor_cost + m.iterations_since_factor;
-    if (!r.converged) {  // refactor now and solve again from the same start
-      refactor();
-      if (m.factor->ready()) {
-        report.iterations += r.iterations;
-        x = start;
-        r = solve_pcg(a, b, free, x, s.tolerance, std::max(1, s.max_iterations - report.iterations), factor);
-      }
-    } else if (r.iterations > s.refresh_iterations || pays) {
-      m.refactor_next = true;
+  const int first_limit = m.factor->ready() ? std::min(s.max_iterations, 3 * s.refresh_iterations) : s.max_iterations;
+  PcgResult r = pcg(first_limit, m.factor->ready() ? factor : Preconditioner());
+  // The factor is of an earlier matrix, and the iterations grow as the matrix drifts from it
+  // (about one more per step in the buckling sleeve). Refactor when this solve cost more than
+  // the average per solve since the last factorisation, the factorisation included (for a cost
+  // that grows steadily this minimises the long-run average), or when it exceeded
+  // refresh_iterations. The new factor is of the next step's matrix (taken at the start of that
+  // step), not of this one, which is solved already: a factor of the matrix being solved needs
+  // 3–4 iterations (half-precision solves), one a step old 5–6 in the sleeve's slow phases and
+  // 9–60 while it snaps into folds. The factorisation's cost in iterations is estimated from its
+  // flop count against the flops of one iteration (two triangular solves and a product with A),
+  // scaled by 0.17, fitted on the 2542-vertex sleeve (2 cores): first with single-precision
+  // solves (factorisation 22 ms ≙ 21 iterations of 1.05 ms), checked again with half-precision
+  // solves (21.5 ms, 0.75 ms per iteration). The optimum is flat: 0.12 / 0.17 / 0.25 / 0.35 /
+  // 0.5 model to 11.4 / 11.3 / 11.7 / 12.0 / 12.5 ms of solve per step (docs/performance.md).
+  // Decided on counts, never on timings: runs are repeatable.
+  ++m.solves_since_factor;
+  m.iterations_since_factor += r.iterations;
+  const double iteration_work = 4.0 * static_cast<double>(m.factor->factor_entries()) + 2.0 * entries;
+  const double factor_cost = 0.17 * m.factor->factor_flops() / std::max(iteration_work, 1.0);
+  const bool pays = r.iterations * m.solves_since_factor > factor_cost + m.iterations_since_factor;
+  if (!r.converged) {  // refactor now and solve again from the same start
+    refactor(report);
+    if (m.factor->ready()) {
+      report.iterations += r.iterations;
+      x = start;
+      r = pcg(std::max(1, s.max_iterations - report.iterations), factor);
     }
+  } else if (r.iterations > s.refresh_iterations || pays) {
+    m.refactor_next = true;
   }
-  report.iterations += r.iterations;
-  report.residual = r.residual;
-  report.converged = r.converged;
-  if (!r.converged) {
-    std::ostringstream text;
-    text << "the conjugate gradient solver did not converge: relative residual " << r.residual << " after "
-         << r.iterations << " iterations (tolerance " << s.tolerance
-         << "); try a smaller time step, more iterations or \"solver\": {\"type\": \"cholmod\"}";
-    report.failure = text.str();
-  }
+  m.finish(r, s, report);
   return report;
 }
 

@@ -10,6 +10,7 @@
 
 #include "sim/solver/pcg.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -78,6 +79,19 @@ class LinearSolver {
   LinearSolveReport solve(Eigen::SparseMatrix<double>& a, Eigen::VectorXd& b, const std::vector<char>& free,
                           Eigen::VectorXd& x);
 
+  // The same solve for a matrix given as an operation: `product` gives y = A x at every entry
+  // (x's constrained entries hold their fixed values and enter the product as the matrix form's
+  // do), `product_entries` its cost in stored entries of a matrix (for the refresh rule), and
+  // `assemble` gives A as a matrix, called only when the preconditioner needs a new factor. For systems whose matrix costs more to assemble than to apply (the step potential's
+  // contact blocks, each over the 12–50 nodes of its surface points' stencils: assembling them
+  // every Newton iteration cost more than the rest of the crushed sleeve's step). Only for
+  // conjugate gradients with the Cholesky preconditioner (solves_operators()); its factor is of
+  // the last assembled matrix, kept while it serves (the same refresh rule as solve()).
+  using MatrixSource = std::function<Eigen::SparseMatrix<double>&()>;
+  bool solves_operators() const;
+  LinearSolveReport solve(const LinearOperator& product, double product_entries, const MatrixSource& assemble,
+                          const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x);
+
   // An approximate inverse of the matrix of the last solve, `a` (as solve() left it) on the
   // entries with free[i] != 0, for further systems with that matrix or one close to it (the
   // contact stage's implicit response): the direct solver's factorisation (exact), the Cholesky
@@ -96,6 +110,12 @@ class LinearSolver {
 
  private:
   struct Impl;
+  // Conjugate gradients with the Cholesky preconditioner, for both forms: `pcg(limit, factor)` runs
+  // the iteration from x, `refactor()` makes a new factor (of the matrix the form gives), `entries`
+  // the stored entries of the system's matrix (the cost of one iteration's product).
+  LinearSolveReport pcg_with_factor(const std::function<PcgResult(int, const Preconditioner&)>& pcg,
+                                    const std::function<void(LinearSolveReport&)>& refactor, double entries,
+                                    Eigen::VectorXd& x);
   LinearSolverSettings settings_;
   std::unique_ptr<Impl> impl_;
 };

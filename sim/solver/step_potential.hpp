@@ -28,11 +28,14 @@ struct PotentialLinearisation {
   Eigen::VectorXd energy_gradient;       // ∇ₓE at x + h v_k, 3·#nodes [N] (zero-sized: none)
   Eigen::VectorXd dissipation_gradient;  // ∇ᵥΨ at v_k, 3·#nodes [N] (zero-sized: none)
   struct Block {
-    NodeRow row;
+    NodeRow row;              // B in node form, or
+    PointRow on_points;       // B on the points of `point_map` (when on_points.count > 0)
     Eigen::Matrix3d hessian;  // H of Bᵀ H B: [N/m] for E, [N·s/m] for Ψ
     bool dissipative = false; // a block of ∇²Ψ (weight h) rather than ∇²E (weight h²)
+    bool is_on_points() const { return on_points.count > 0; }
   };
   std::vector<Block> blocks;
+  const PointMap* point_map = nullptr;  // the points of the blocks on points (the potential's own)
   int active = 0;  // active pairs (barrier) this linearisation holds
   bool empty() const { return blocks.empty() && energy == 0.0 && dissipation == 0.0; }
 };

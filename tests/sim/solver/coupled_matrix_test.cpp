@@ -97,5 +97,50 @@ TEST(CoupledMatrix, CoversOnlyItsCouplingsAndARebuildCanKeepThem) {
   EXPECT_FALSE(m.covers(chain(8), {}));
 }
 
+// A row on points against the same row written out over the nodes: p_i = Σ_j w_ij x_j with
+// points sharing nodes (as neighbouring surface points share their stencils).
+TEST(PointRow, ActsAsItsNodeFormAndMergesSharedNodes) {
+  PointMap map;
+  const std::vector<std::vector<std::pair<int, double>>> stencils = {
+      {{0, 0.5}, {1, 0.25}, {2, 0.25}}, {{1, 0.5}, {2, 0.5}}, {{2, 0.2}, {3, 0.3}, {4, 0.5}}, {{5, 1.0}}, {{4, 0.6}, {6, 0.4}}};
+  for (const auto& stencil : stencils) {
+    for (const auto& [node, w] : stencil) {
+      map.nodes.push_back(node);
+      map.weights.push_back(w);
+    }
+    map.offsets.push_back(static_cast<int>(map.nodes.size()));
+  }
+  ASSERT_EQ(map.num_points(), 5);
+  PointRow row;  // an edge–edge pair: (1 − a) p0 + a p1 − (1 − b) p2 − b p4
+  row.count = 4;
+  row.points = {0, 1, 2, 4};
+  row.coefs = {0.7, 0.3, -0.4, -0.6};
+  // Its node form by hand: node 0: 0.35; 1: 0.175 + 0.15; 2: 0.175 + 0.15 − 0.08; 3: −0.12;
+  // 4: −0.2 − 0.36; 6: −0.24.
+  const std::vector<std::pair<int, double>> expected = {{0, 0.35}, {1, 0.325}, {2, 0.245}, {3, -0.12}, {4, -0.56}, {6, -0.24}};
+  const NodeRow nodes = row.node_row(map);
+  ASSERT_EQ(nodes.nodes.size(), expected.size());
+  for (size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(nodes.nodes[k].first, expected[k].first);
+    EXPECT_NEAR(nodes.nodes[k].second, expected[k].second, 1e-15);
+  }
+  EXPECT_TRUE(nodes.dofs.empty());
+  EXPECT_EQ(row.entries(map), 3 + 2 + 3 + 2);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::VectorXd x(21), y0 = Eigen::VectorXd::Zero(21), y1 = Eigen::VectorXd::Zero(21);
+  for (Eigen::Index i = 0; i < x.size(); ++i) x(i) = u(rng);
+  EXPECT_LT((row.apply(map, x) - nodes.apply(x)).norm(), 1e-14);
+  const Eigen::Vector3d f(0.3, -1.2, 2.0);
+  row.scatter(map, f, y0);
+  nodes.scatter(f, y1);
+  EXPECT_LT((y0 - y1).norm(), 1e-14);
+  EXPECT_EQ(y0.segment<3>(15), Eigen::Vector3d::Zero());  // node 5 is not in the row
+  PointRow other = row;
+  EXPECT_TRUE(other == row);
+  other.coefs[2] = -0.5;
+  EXPECT_FALSE(other == row);
+}
+
 }  // namespace
 }  // namespace clothsim
