@@ -167,7 +167,7 @@ TEST(FuzzObjInput, ReadErrorsAreMeshErrors) {
 // fuzz_scene's first finding (fuzz/regressions/scene/capsule_length_1e120.json): a capsule
 // 8.9e119 m long asked for 2.9e122 rings along its side, converted to int before it was clamped
 // to 200 (UBSan: float-cast-overflow; without the sanitizer the count came out as INT_MIN,
-// clamped to 1 ring). Any capsule longer than 200 segment lengths has 200.
+// clamped to 1 ring). Any capsule longer than 800 segment lengths (rings are 4 apart) has 200.
 TEST(FuzzFindings, VeryLongCapsuleHasTheMostRingsNotOne) {
   Obstacle capsule;
   capsule.shape = Obstacle::Shape::capsule;
