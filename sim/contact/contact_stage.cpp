@@ -2,9 +2,11 @@
 
 #include "sim/contact/barrier.hpp"
 #include "sim/contact/candidates.hpp"
+#include "sim/contact/collision_surface.hpp"
 #include "sim/contact/impact_zones.hpp"
 #include "sim/contact/narrow_phase.hpp"
 #include "sim/contact/obstacle_set.hpp"
+#include "sim/contact/pair_geometry.hpp"
 #include "sim/contact/pair_types.hpp"
 #include "sim/solver/cholesky_preconditioner.hpp"
 
@@ -33,36 +35,17 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-using contact::Box;
+using contact::box_gap;
 using contact::Bounds;
 using contact::Candidate;
 using contact::Constraint;
 using contact::fit_rigid;
+using contact::is_point_triangle;
 using contact::Kind;
 using contact::PairGeometry;
 using contact::RigidMap;
-using contact::shares_vertex;
-using contact::swept_box;
+using contact::sign_by_start;
 using contact::Zones;
-
-// y = A X for a row-major sparse A and a dense X with `cols` columns (column-major, X.rows() =
-// A.cols()), rows on all cores; each entry is summed in the row's stored order, as Eigen does.
-void parallel_product(const Eigen::SparseMatrix<double, Eigen::RowMajor>& a, const double* x, Eigen::Index x_rows, int cols,
-                      double* y) {
-  if (!a.isCompressed()) throw std::logic_error("parallel_product: the matrix must be compressed");
-  const Eigen::Index rows = a.rows();
-  const int* outer = a.outerIndexPtr();
-  const int* inner = a.innerIndexPtr();
-  const double* value = a.valuePtr();
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, rows, 2048), [&](const tbb::blocked_range<Eigen::Index>& range) {
-    for (Eigen::Index r = range.begin(); r != range.end(); ++r)
-      for (int c = 0; c < cols; ++c) {
-        double sum = 0.0;
-        for (int k = outer[r]; k < outer[r + 1]; ++k) sum += value[k] * x[c * x_rows + inner[k]];
-        y[c * rows + r] = sum;
-      }
-  });
-}
 
 }  // namespace
 
@@ -72,28 +55,15 @@ struct ContactStage::Impl {
   ContactParameters params;
   std::vector<Obstacle> obstacles;
 
-  // The collision surface.
-  SurfaceOperator surface;
-  Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;  // 3·#P × 3·#nodes
-  Eigen::MatrixX3d rest_points;                          // #P × 3
-  std::vector<std::array<int, 2>> edges;                 // surface edges (points)
-  std::vector<std::array<int, 3>> triangle_edges;        // per surface triangle
-  std::vector<std::vector<int>> owned_points, owned_edges;  // per surface triangle (build_ownership)
+  contact::CollisionSurface surf;  // the collision surface (sim/contact/collision_surface.hpp)
   std::vector<char> free;
   Eigen::VectorXd node_mass;
 
   contact::ObstacleSet obs;  // the obstacles' meshes, combined (planes apart)
+  contact::PairPrimitives pairs;  // the pairs' geometry over the surface and obs (sim/contact/pair_geometry.hpp)
 
-  // Patches: the fine triangles over one surface triangle of the discretisation (display
-  // triangle i lies over surface triangle i / 4^levels). The candidate search (the broad phase,
-  // sim/contact/candidates.hpp) works on patches, then down to the fine triangles.
-  int fine_per_patch = 1;
-  int num_patches = 0;
-  long long joined_pairs = 0;  // pairs of fine triangles joined at rest (find_near_at_rest)
+  long long joined_pairs = 0;  // pairs of fine triangles joined at rest (CollisionSurface::find_near_at_rest)
   std::optional<contact::CandidateSearch> search;  // (made last in the constructor)
-
-  // Scratch for building constraints: slot per DOF (−1 when unused).
-  std::vector<int> slot;
 
   // Per step.
   Eigen::MatrixX3d p0, p1;          // surface points at the start and end of the step
@@ -103,30 +73,33 @@ struct ContactStage::Impl {
   bool obstacles_static = false;
   double h = 0.0;
 
-  Impl(const Discretization& disc, const Eigen::VectorXd& mass, const std::vector<char>& free_dofs,
-       const CollisionSettings& s, std::vector<Obstacle> obstacle_list, const ContactParameters& p)
-      : d(disc), settings(s), params(p), obstacles(std::move(obstacle_list)), free(free_dofs), node_mass(mass) {
+  // The parameters, once the settings read before the collision surface is built are checked.
+  static const ContactParameters& checked(const CollisionSettings& settings, const ContactParameters& params) {
     if (!(settings.thickness > 0)) throw std::invalid_argument("collision: the thickness must be > 0 [m]");
     if (!(settings.friction >= 0)) throw std::invalid_argument("collision: the friction coefficient must be >= 0");
     if (!(settings.tolerance > 0 && settings.tolerance <= 0.1))
       throw std::invalid_argument("collision: the tolerance must be > 0 and at most 0.1");
     if (params.surface_level < 0) throw std::invalid_argument("collision: the surface level must be >= 0");
-    surface = d.display(params.surface_level);
-    surface.position.makeCompressed();
-    jacobian = d.point_jacobian(surface);
-    jacobian.makeCompressed();
-    rest_points = d.surface_positions(surface, d.rest());
+    return params;
+  }
+
+  Impl(const Discretization& disc, const Eigen::VectorXd& mass, const std::vector<char>& free_dofs,
+       const CollisionSettings& s, std::vector<Obstacle> obstacle_list, const ContactParameters& p)
+      : d(disc),
+        settings(s),
+        params(checked(s, p)),
+        obstacles(std::move(obstacle_list)),
+        surf(disc, params.surface_level),
+        free(free_dofs),
+        node_mass(mass),
+        pairs(surf.triangles(), surf.edges(), obs) {
     const int n3 = 3 * d.num_nodes();
     if (static_cast<int>(free.size()) != n3 || node_mass.size() != d.num_nodes())
       throw std::invalid_argument("ContactStage: the masses and the free-DOF mask must cover every node");
-    slot.assign(static_cast<size_t>(n3), -1);
-    contact::build_edges(surface.triangles, edges, triangle_edges);
-    contact::build_ownership(surface.triangles, static_cast<int>(rest_points.rows()), triangle_edges, static_cast<int>(edges.size()),
-                    owned_points, owned_edges);
-    fine_per_patch = 1 << (2 * surface.levels);
-    num_patches = static_cast<int>(surface.triangles.size()) / fine_per_patch;
     std::vector<std::vector<int>> near_at_rest, joined_at_rest;
-    if (settings.self) find_near_at_rest(near_at_rest, joined_at_rest);
+    if (settings.self)
+      joined_pairs = surf.find_near_at_rest(2.0 * settings.thickness, params.near_separation_ratio * settings.thickness,
+                                            d.control_triangles(), near_at_rest, joined_at_rest);
     if (!(settings.flat_region_angle >= 0 && settings.flat_region_angle < 0.5 * M_PI))
       throw std::invalid_argument("collision: the flat-region angle must be >= 0 and < pi/2 [rad]");
 
@@ -139,20 +112,12 @@ struct ContactStage::Impl {
     search_settings.flat_region_angle = settings.flat_region_angle;
     search_settings.min_separation_ratio = params.min_separation_ratio;
     search_settings.near_separation_ratio = params.near_separation_ratio;
-    search.emplace(contact::SearchSurface{surface.triangles, surface.levels, edges, triangle_edges, owned_points, owned_edges,
-                                          d.control_triangles(), d.num_nodes()},
+    search.emplace(contact::SearchSurface{surf.triangles(), surf.op().levels, surf.edges(), surf.triangle_edges(),
+                                          surf.owned_points(), surf.owned_edges(), d.control_triangles(), d.num_nodes()},
                    std::move(near_at_rest), std::move(joined_at_rest), obs, search_settings);
   }
 
-  // A point–obstacle-triangle pair that adds nothing (contact::ObstacleSet::redundant_on_flat_face).
-  bool redundant_on_flat_face_pair(const Candidate& c, const PairGeometry& g, const std::array<Eigen::Vector3d, 4>& x) const {
-    return c.kind == Kind::cloth_point_obstacle_triangle &&
-           obs.redundant_on_flat_face(c.b, {-g.coef[1], -g.coef[2], -g.coef[3]}, g.normal, x[1], x[2], x[3]);
-  }
-
   // --- Positions -------------------------------------------------------------------------------
-  Eigen::Vector3d cloth(const Eigen::MatrixX3d& p, int i) const { return p.row(i).transpose(); }
-
   bool end_points_current = false;  // p1 matches the velocities (no impulse since it was computed)
 
   void update_end_points(const Eigen::VectorXd& v) {
@@ -161,33 +126,8 @@ struct ContactStage::Impl {
     p1 = end_points_of(v);
   }
 
-  // The end points p0 + h J v (#P × 3) for velocities v. With the points' rows in node form
-  // (potential mode) one pass over each point's nodes gives all three components (the same sums,
-  // in the same order, as J's three rows).
-  Eigen::MatrixX3d end_points_of(const Eigen::VectorXd& v) const {
-    Eigen::MatrixX3d out(p0.rows(), 3);
-    if (point_rows_in_node_form) {
-      tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p0.rows(), 2048), [&](const tbb::blocked_range<Eigen::Index>& range) {
-        for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
-          double x = 0.0, y = 0.0, z = 0.0;
-          for (int k = point_offsets[static_cast<size_t>(p)]; k < point_offsets[static_cast<size_t>(p) + 1]; ++k) {
-            const double w = point_weights[static_cast<size_t>(k)];
-            const double* vn = v.data() + 3 * static_cast<Eigen::Index>(point_nodes[static_cast<size_t>(k)]);
-            x += w * vn[0];
-            y += w * vn[1];
-            z += w * vn[2];
-          }
-          out(p, 0) = p0(p, 0) + h * x;
-          out(p, 1) = p0(p, 1) + h * y;
-          out(p, 2) = p0(p, 2) + h * z;
-        }
-      });
-      return out;
-    }
-    Eigen::VectorXd pv(jacobian.rows());  // surface point velocities, flat
-    parallel_product(jacobian, v.data(), v.size(), 1, pv.data());
-    return p0 + h * Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(pv.data(), p0.rows(), 3);
-  }
+  // The end points p0 + h J v (#P × 3) for velocities v.
+  Eigen::MatrixX3d end_points_of(const Eigen::VectorXd& v) const { return surf.end_points(p0, h, v); }
 
   // --- Broad phase ----------------------------------------------------------------------------
   // The candidates of the motion p0 → p1 (and the obstacles' o0 → o1) with boxes grown by `grow`
@@ -199,218 +139,26 @@ struct ContactStage::Impl {
     return out;
   }
 
-  // --- Fine triangles near each other at rest ---------------------------------------------------
-  // Distance between two triangles of the collision surface at positions `p` [m].
-  double triangle_distance(const Eigen::MatrixX3d& p, const std::array<int, 3>& a, const std::array<int, 3>& b) const {
-    double dist = std::numeric_limits<double>::infinity();
-    auto pt = [&](int i) -> Eigen::Vector3d { return p.row(i).transpose(); };
-    for (size_t k = 0; k < 3; ++k) {
-      dist = std::min(dist, contact::point_triangle(pt(a[k]), pt(b[0]), pt(b[1]), pt(b[2])).distance);
-      dist = std::min(dist, contact::point_triangle(pt(b[k]), pt(a[0]), pt(a[1]), pt(a[2])).distance);
-      for (size_t l = 0; l < 3; ++l)
-        dist = std::min(dist, contact::edge_edge(pt(a[k]), pt(a[(k + 1) % 3]), pt(b[l]), pt(b[(l + 1) % 3])).distance);
-    }
-    return dist;
-  }
-
-  // Whether two triangles are within `near` at rest: sharing a vertex, two vertices closer than
-  // `near` (enough, and decides most pairs of a finely refined surface cheaply), or else their
-  // exact distance below it: the exact distance's verdict (a vertex pair bounds it from above,
-  // bounding spheres from below; both only skip the exact test where it could not differ).
-  bool near_pair(const std::array<int, 3>& a, const std::array<int, 3>& b, double near) const {
-    if (shares_vertex(a, b)) return true;
-    const double near2 = near * near;
-    for (int x : a)
-      for (int y : b)
-        if ((rest_points.row(x) - rest_points.row(y)).squaredNorm() < near2) return true;
-    // Bounding spheres about the centroids bound the distance from below.
-    auto sphere = [&](const std::array<int, 3>& t, Eigen::RowVector3d& centre) {
-      centre = (rest_points.row(t[0]) + rest_points.row(t[1]) + rest_points.row(t[2])) / 3.0;
-      double radius = 0.0;
-      for (int x : t) radius = std::max(radius, (rest_points.row(x) - centre).norm());
-      return radius;
-    };
-    Eigen::RowVector3d ca, cb;
-    const double ra = sphere(a, ca), rb = sphere(b, cb);
-    if ((ca - cb).norm() - ra - rb > near * (1.0 + 1e-12)) return false;
-    return triangle_distance(rest_points, a, b) < near;
-  }
-
-  // Per fine triangle a: the sorted b > a within twice the thickness of it at rest (near_at_rest),
-  // and those of them that touch it at rest without being neighbours in the material
-  // (joined_at_rest, counted in joined_pairs); sim/contact/candidates.hpp has what they do.
-  void find_near_at_rest(std::vector<std::vector<int>>& near_at_rest, std::vector<std::vector<int>>& joined_at_rest) {
-    const double near = 2.0 * settings.thickness;
-    near_at_rest.assign(surface.triangles.size(), {});
-    std::vector<Box> boxes(surface.triangles.size());
-    for (size_t t = 0; t < surface.triangles.size(); ++t) boxes[t] = swept_box(rest_points, rest_points, surface.triangles[t], 0.5 * near);
-    contact::BroadPhase rest_broad;
-    const std::vector<std::pair<int, int>> pairs = rest_broad.self_pairs(boxes);
-    // The predicate in parallel (one flag per pair), the lists in the pairs' order: the same
-    // lists as a serial pass.
-    std::vector<char> is_near(pairs.size(), 0), is_joined(pairs.size(), 0);
-    const double joined = params.near_separation_ratio * settings.thickness;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, pairs.size(), 1024), [&](const tbb::blocked_range<size_t>& range) {
-      for (size_t i = range.begin(); i != range.end(); ++i) {
-        const auto& a = surface.triangles[static_cast<size_t>(pairs[i].first)];
-        const auto& b = surface.triangles[static_cast<size_t>(pairs[i].second)];
-        is_near[i] = near_pair(a, b, near);
-        if (!is_near[i]) continue;
-        const auto& pa = d.control_triangles()[static_cast<size_t>(pairs[i].first / fine_per_patch)];
-        const auto& pb = d.control_triangles()[static_cast<size_t>(pairs[i].second / fine_per_patch)];
-        is_joined[i] = !shares_vertex(pa, pb) && triangle_distance(rest_points, a, b) < joined;
-      }
-    });
-    joined_at_rest.assign(surface.triangles.size(), {});
-    for (size_t i = 0; i < pairs.size(); ++i) {
-      if (is_near[i]) near_at_rest[static_cast<size_t>(pairs[i].first)].push_back(pairs[i].second);
-      if (is_joined[i]) {
-        joined_at_rest[static_cast<size_t>(pairs[i].first)].push_back(pairs[i].second);
-        ++joined_pairs;
-      }
-    }
-    // sorted: the pairs come sorted
-  }
-
   // --- Pair geometry ---------------------------------------------------------------------------
   // The four points of a pair at the start (τ = 0) or end (τ = 1) of the step.
   std::array<Eigen::Vector3d, 4> corners(const Candidate& c, bool end) const {
-    const Eigen::MatrixX3d& p = end ? p1 : p0;
-    const Eigen::MatrixX3d& o = end ? o1 : o0;
-    auto cp = [&](int i) -> Eigen::Vector3d { return p.row(i).transpose(); };
-    auto op = [&](int i) -> Eigen::Vector3d { return o.row(i).transpose(); };
-    switch (c.kind) {
-      case Kind::cloth_point_cloth_triangle: {
-        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-        return {cp(c.a), cp(t[0]), cp(t[1]), cp(t[2])};
-      }
-      case Kind::cloth_edge_cloth_edge: {
-        const auto& ea = edges[static_cast<size_t>(c.a)];
-        const auto& eb = edges[static_cast<size_t>(c.b)];
-        return {cp(ea[0]), cp(ea[1]), cp(eb[0]), cp(eb[1])};
-      }
-      case Kind::cloth_point_obstacle_triangle: {
-        const auto& t = obs.triangles[static_cast<size_t>(c.b)];
-        return {cp(c.a), op(t[0]), op(t[1]), op(t[2])};
-      }
-      case Kind::obstacle_point_cloth_triangle: {
-        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-        return {op(c.a), cp(t[0]), cp(t[1]), cp(t[2])};
-      }
-      case Kind::cloth_edge_obstacle_edge: {
-        const auto& ea = edges[static_cast<size_t>(c.a)];
-        const auto& eb = obs.edges[static_cast<size_t>(c.b)];
-        return {cp(ea[0]), cp(ea[1]), op(eb[0]), op(eb[1])};
-      }
-    }
-    return {};
-  }
-
-  bool is_point_triangle(Kind k) const { return k != Kind::cloth_edge_cloth_edge && k != Kind::cloth_edge_obstacle_edge; }
-
-  // The pair's points, coefficients, normal and distance for the four corners `x`.
-  PairGeometry geometry(const Candidate& c, const std::array<Eigen::Vector3d, 4>& x) const {
-    PairGeometry g;
-    g.num = 4;
-    std::array<int, 4> ids{};
-    std::array<bool, 4> obstacle{};
-    switch (c.kind) {
-      case Kind::cloth_point_cloth_triangle: {
-        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-        ids = {c.a, t[0], t[1], t[2]};
-        break;
-      }
-      case Kind::cloth_edge_cloth_edge: {
-        const auto& ea = edges[static_cast<size_t>(c.a)];
-        const auto& eb = edges[static_cast<size_t>(c.b)];
-        ids = {ea[0], ea[1], eb[0], eb[1]};
-        break;
-      }
-      case Kind::cloth_point_obstacle_triangle: {
-        const auto& t = obs.triangles[static_cast<size_t>(c.b)];
-        ids = {c.a, t[0], t[1], t[2]};
-        obstacle = {false, true, true, true};
-        break;
-      }
-      case Kind::obstacle_point_cloth_triangle: {
-        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-        ids = {c.a, t[0], t[1], t[2]};
-        obstacle = {true, false, false, false};
-        break;
-      }
-      case Kind::cloth_edge_obstacle_edge: {
-        const auto& ea = edges[static_cast<size_t>(c.a)];
-        const auto& eb = obs.edges[static_cast<size_t>(c.b)];
-        ids = {ea[0], ea[1], eb[0], eb[1]};
-        obstacle = {false, false, true, true};
-        break;
-      }
-    }
-    g.point = ids;
-    g.obstacle = obstacle;
-    if (is_point_triangle(c.kind)) {
-      const contact::PointTriangleProximity q = contact::point_triangle(x[0], x[1], x[2], x[3]);
-      g.coef = {1.0, -q.weights[0], -q.weights[1], -q.weights[2]};
-      g.normal = q.normal;
-      g.distance = q.distance;
-    } else {
-      const contact::EdgeEdgeProximity q = contact::edge_edge(x[0], x[1], x[2], x[3]);
-      g.coef = {1.0 - q.s, q.s, -(1.0 - q.t), -q.t};
-      g.normal = q.normal;
-      g.distance = q.distance;
-    }
-    return g;
-  }
-
-  int obstacle_of(const PairGeometry& g) const {
-    for (int k = 0; k < g.num; ++k)
-      if (g.obstacle[static_cast<size_t>(k)]) return obs.obstacle_of_vertex[static_cast<size_t>(g.point[static_cast<size_t>(k)])];
-    return -1;
+    return end ? pairs.corners(c, p1, o1) : pairs.corners(c, p0, o0);
   }
 
   // The constraint of a pair's geometry: B over the DOFs through J, the obstacle side's velocity.
   Constraint constraint(const PairGeometry& g) {
     Constraint c;
     c.normal = g.normal;
-    c.obstacle = obstacle_of(g);
+    c.obstacle = pairs.obstacle_of(g);
     c.mu = c.obstacle >= 0 ? obstacles[static_cast<size_t>(c.obstacle)].friction : settings.friction;
     for (int k = 0; k < g.num; ++k) {
       const double coef = g.coef[static_cast<size_t>(k)];
       const int p = g.point[static_cast<size_t>(k)];
       if (coef == 0.0) continue;
-      if (g.obstacle[static_cast<size_t>(k)]) {
-        c.obstacle_velocity += coef * (o1.row(p) - o0.row(p)).transpose() / h;
-        continue;
-      }
-      for (int comp = 0; comp < 3; ++comp)
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(jacobian, 3 * p + comp); it; ++it) {
-          const int dof = static_cast<int>(it.col());
-          int& s = slot[static_cast<size_t>(dof)];
-          if (s < 0) {
-            s = static_cast<int>(c.b.size());
-            c.b.emplace_back(dof, Eigen::Vector3d::Zero());
-          }
-          c.b[static_cast<size_t>(s)].second[comp] += coef * it.value();
-        }
+      if (g.obstacle[static_cast<size_t>(k)]) c.obstacle_velocity += coef * (o1.row(p) - o0.row(p)).transpose() / h;
     }
-    for (const auto& entry : c.b) slot[static_cast<size_t>(entry.first)] = -1;
+    c.b = surf.rows(g);
     return c;
-  }
-
-  // --- Obstacle motion over the step ------------------------------------------------------------
-  // The rigid map that takes the obstacle from its place at time t to its place at t + h.
-  RigidMap step_map(const Obstacle& o, double t) const {
-    auto pose = [&](double time) {
-      RigidMap m;
-      m.c = obstacle_point(o, Eigen::Vector3d::Zero(), time);
-      for (int k = 0; k < 3; ++k) m.r.col(k) = obstacle_point(o, Eigen::Vector3d::Unit(k), time) - m.c;
-      return m;
-    };
-    const RigidMap a = pose(t), b = pose(t + h);
-    RigidMap m;
-    m.r = b.r * a.r.transpose();
-    m.c = b.c - m.r * a.c;
-    return m;
   }
 
   // --- Narrow phase ------------------------------------------------------------------------------
@@ -458,7 +206,7 @@ struct ContactStage::Impl {
       Eigen::Vector3d q0, n0, q1, n1;
       plane_at(o, t, q0, n0);
       plane_at(o, t + h, q1, n1);
-      const RigidMap move = step_map(o, t);
+      const RigidMap move = contact::obstacle_step_map(o, t, h);
       for (Eigen::Index p = 0; p < p0.rows(); ++p) {
         ++report.pairs_tested;
         const Eigen::Vector3d a = p0.row(p).transpose();
@@ -489,48 +237,22 @@ struct ContactStage::Impl {
       for (size_t i = range.begin(); i != range.end(); ++i)
         if (!cands[i].near) {  // neighbours in the material: only kept from crossing (collisions)
           const std::array<Eigen::Vector3d, 4> x = corners(cands[i], false);
-          const PairGeometry g = geometry(cands[i], x);
-          close[i] = g.distance < settings.thickness && !redundant_on_flat_face_pair(cands[i], g, x);
+          const PairGeometry g = pairs.geometry(cands[i], x);
+          close[i] = g.distance < settings.thickness && !pairs.redundant_on_flat_face(cands[i], g, x);
         }
     });
     for (size_t i = 0; i < cands.size(); ++i) {
       if (!cands[i].near) ++report.pairs_tested;
       if (!close[i]) continue;
-      const PairGeometry g = geometry(cands[i], corners(cands[i], false));
+      const PairGeometry g = pairs.geometry(cands[i], corners(cands[i], false));
       out.push_back({constraint(g), g.distance, 0.0, key_of(cands[i], 0)});
     }
     plane_pairs(t, /*end=*/false, settings.thickness, out, report);
     report.narrow_ms += ms_since(t0);
     return out;
   }
-
   // Pairs whose distance may fall below the minimum separation during the step (CCD), with their
   // geometry at the (conservative) time of impact.
-  // The cloth points of a pair (up to four; −1 for none).
-  std::array<int, 4> cloth_points_of(const Candidate& c) const {
-    switch (c.kind) {
-      case Kind::cloth_point_cloth_triangle: {
-        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-        return {c.a, t[0], t[1], t[2]};
-      }
-      case Kind::cloth_edge_cloth_edge: {
-        const auto& ea = edges[static_cast<size_t>(c.a)];
-        const auto& eb = edges[static_cast<size_t>(c.b)];
-        return {ea[0], ea[1], eb[0], eb[1]};
-      }
-      case Kind::cloth_point_obstacle_triangle: return {c.a, -1, -1, -1};
-      case Kind::obstacle_point_cloth_triangle: {
-        const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-        return {t[0], t[1], t[2], -1};
-      }
-      case Kind::cloth_edge_obstacle_edge: {
-        const auto& ea = edges[static_cast<size_t>(c.a)];
-        return {ea[0], ea[1], -1, -1};
-      }
-    }
-    return {-1, -1, -1, -1};
-  }
-
   // Pairs whose distance may fall below the minimum separation during the step. With `moved`
   // (per surface point: its end position changed since the last test) and `last` (the pairs
   // that collided then, sorted), only pairs with a moved point or a previous collision are
@@ -558,10 +280,10 @@ struct ContactStage::Impl {
         const size_t i = close_only ? bounds->close[j] : j;
         const Candidate& c = cands[i];
         const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
-        if (lower != nullptr && (*lower)[i] - pair_motion(c, point_move, obstacle_motion) > separation) continue;
+        if (lower != nullptr && (*lower)[i] - pairs.motion(c, point_move, obstacle_motion) > separation) continue;
         if (moved != nullptr) {
           bool any = false;
-          for (int p : cloth_points_of(c)) any = any || (p >= 0 && (*moved)[static_cast<size_t>(p)]);
+          for (int p : pairs.cloth_points(c)) any = any || (p >= 0 && (*moved)[static_cast<size_t>(p)]);
           if (!any && !std::binary_search(last->begin(), last->end(), c)) continue;
         }
         ++count;
@@ -580,8 +302,8 @@ struct ContactStage::Impl {
       const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
       std::array<Eigen::Vector3d, 4> x;
       for (size_t k = 0; k < 4; ++k) x[k] = a[k] + toi[i] * (b[k] - a[k]);
-      const PairGeometry g = geometry(c, x);
-      if (redundant_on_flat_face_pair(c, g, x)) continue;
+      const PairGeometry g = pairs.geometry(c, x);
+      if (pairs.redundant_on_flat_face(c, g, x)) continue;
       out.push_back({constraint(g), g.distance, separation, key_of(c, 1)});
       if (hit_pairs) hit_pairs->push_back(c);
     }
@@ -656,7 +378,7 @@ struct ContactStage::Impl {
         con.friction.setZero();
         continue;
       }
-      to_node_form(r.row.dofs, r.row.nodes);
+      surf.to_node_form(r.row.dofs, r.row.nodes);
       r.normal = con.normal;
       r.tangent -= con.normal * con.normal.transpose();
       r.kappa = params.penalty_ratio / w;
@@ -828,32 +550,6 @@ struct ContactStage::Impl {
 
   double diagonal(int dof) const { return system_diagonal(dof); }
 
-  // Moves the free-DOF list `b` of a constraint into the node form (see implicit_response's Row)
-  // when it has that shape: every node with all three DOFs, b(3k + c) = w e_c with one w per node.
-  // The nodes keep the order of their x DOFs in `b`, so the sums over them are the same.
-  void to_node_form(std::vector<std::pair<int, Eigen::Vector3d>>& b, std::vector<std::pair<int, double>>& nodes) {
-    nodes.clear();
-    if (b.size() % 3 != 0) return;
-    for (size_t i = 0; i < b.size(); ++i) slot[static_cast<size_t>(b[i].first)] = static_cast<int>(i);
-    bool ok = true;
-    for (const auto& [dof, vec] : b) {
-      const int c = dof % 3;
-      const double w = vec[c];
-      for (int k = 0; k < 3 && ok; ++k) {
-        const int at = slot[static_cast<size_t>(dof - c + k)];
-        ok = at >= 0 && b[static_cast<size_t>(at)].second == w * Eigen::Vector3d::Unit(k);
-      }
-      if (!ok) break;
-      if (c == 0) nodes.emplace_back(dof / 3, w);
-    }
-    for (const auto& entry : b) slot[static_cast<size_t>(entry.first)] = -1;
-    if (ok) {
-      b.clear();
-    } else {
-      nodes.clear();
-    }
-  }
-
   // --- Fail-safe: impact zones -------------------------------------------------------------------
   void move_zones(Zones& zones, const std::vector<int>& zone_obstacle, const Eigen::VectorXd& x, double t,
                   Eigen::VectorXd& v, ContactReport& report) {
@@ -881,7 +577,7 @@ struct ContactStage::Impl {
       RigidMap map;
       bool have_map = false;
       if (obstacle >= 0) {
-        map = step_map(obstacles[static_cast<size_t>(obstacle)], t);
+        map = contact::obstacle_step_map(obstacles[static_cast<size_t>(obstacle)], t, h);
         have_map = true;
       } else if (!from.empty()) {
         map = fit_rigid(from, to);
@@ -943,80 +639,6 @@ struct ContactStage::Impl {
   std::vector<PairGeometry> end_geometry;         // scratch of linearise_potential
 
   double barrier_ratio() const { return params.barrier_ratio; }
-
-  // The constraint's row over the DOFs in node form where it has that shape (NodeRow).
-  NodeRow node_row(const Constraint& c) {
-    NodeRow row;
-    row.dofs = c.b;
-    to_node_form(row.dofs, row.nodes);
-    return row;
-  }
-
-  // Per surface point, its row of J in node form with the nodes sorted (made by enable_potential;
-  // empty rows when some point's row does not have that form, and pair_row takes the long way).
-  std::vector<NodeRow> point_rows;
-  bool point_rows_in_node_form = false;
-  std::vector<int> point_offsets, point_nodes;  // the same rows packed (CSR), for end_points_of
-  std::vector<double> point_weights;
-  void make_point_rows() {
-    point_rows.assign(static_cast<size_t>(rest_points.rows()), NodeRow{});
-    point_rows_in_node_form = true;
-    for (Eigen::Index p = 0; p < rest_points.rows(); ++p) {
-      NodeRow row = node_row(point_constraint(static_cast<int>(p), Eigen::Vector3d::UnitZ()));
-      if (!row.dofs.empty()) {
-        point_rows_in_node_form = false;
-        point_rows.clear();
-        return;
-      }
-      std::sort(row.nodes.begin(), row.nodes.end());
-      point_rows[static_cast<size_t>(p)] = std::move(row);
-    }
-    point_offsets.assign(1, 0);
-    point_nodes.clear();
-    point_weights.clear();
-    for (const NodeRow& row : point_rows) {
-      for (const auto& [node, w] : row.nodes) {
-        point_nodes.push_back(node);
-        point_weights.push_back(w);
-      }
-      point_offsets.push_back(static_cast<int>(point_nodes.size()));
-    }
-  }
-  // The row of a pair's relative position over the nodes, Σ_k c_k J_k (cloth points only).
-  NodeRow pair_row(const PairGeometry& g) {
-    if (!point_rows_in_node_form) return node_row(constraint(g));
-    // One cloth point (against an obstacle or a plane): its row, scaled (the same values as the
-    // merge below gives, without it).
-    int cloth = -1, count = 0;
-    for (int k = 0; k < g.num; ++k)
-      if (!g.obstacle[static_cast<size_t>(k)] && g.coef[static_cast<size_t>(k)] != 0.0) {
-        cloth = k;
-        ++count;
-      }
-    if (count == 1) {
-      NodeRow row = point_rows[static_cast<size_t>(g.point[static_cast<size_t>(cloth)])];
-      const double coef = g.coef[static_cast<size_t>(cloth)];
-      if (coef != 1.0)
-        for (auto& entry : row.nodes) entry.second *= coef;
-      return row;
-    }
-    NodeRow row;
-    for (int k = 0; k < g.num; ++k) {
-      const double coef = g.coef[static_cast<size_t>(k)];
-      if (g.obstacle[static_cast<size_t>(k)] || coef == 0.0) continue;
-      for (const auto& [node, w] : point_rows[static_cast<size_t>(g.point[static_cast<size_t>(k)])].nodes) {
-        int& s = slot[static_cast<size_t>(3 * node)];
-        if (s < 0) {
-          s = static_cast<int>(row.nodes.size());
-          row.nodes.emplace_back(node, 0.0);
-        }
-        row.nodes[static_cast<size_t>(s)].second += coef * w;
-      }
-    }
-    for (const auto& entry : row.nodes) slot[static_cast<size_t>(3 * entry.first)] = -1;
-    std::sort(row.nodes.begin(), row.nodes.end());
-    return row;
-  }
   // The obstacle side's part of a pair's relative velocity over the step [m/s].
   Eigen::Vector3d obstacle_side_velocity(const PairGeometry& g) const {
     Eigen::Vector3d u = Eigen::Vector3d::Zero();
@@ -1028,7 +650,7 @@ struct ContactStage::Impl {
     return u;
   }
   double pair_friction(const PairGeometry& g) const {
-    const int o = obstacle_of(g);
+    const int o = pairs.obstacle_of(g);
     return o >= 0 ? obstacles[static_cast<size_t>(o)].friction : settings.friction;
   }
 
@@ -1037,7 +659,7 @@ struct ContactStage::Impl {
   // step's own system is under it, whatever the material and step.
   double pair_stiffness(const Candidate& c) const {
     double m = std::numeric_limits<double>::infinity();
-    for (int p : cloth_points_of(c))
+    for (int p : pairs.cloth_points(c))
       if (p >= 0) m = std::min(m, point_mass(p));
     return barrier_ratio() * m / (h * h);
   }
@@ -1135,7 +757,7 @@ struct ContactStage::Impl {
     auto visit = [&](size_t i) {
       const Candidate& c = potential_cands[i];
       if (carried) {
-        const double bound = lin_bounds.lower[i] - pair_motion(c, point_move, 0.0);
+        const double bound = lin_bounds.lower[i] - pairs.motion(c, point_move, 0.0);
         lower[i] = std::max(0.0, bound);
         if (bound >= settings.thickness) return;
       }
@@ -1144,7 +766,7 @@ struct ContactStage::Impl {
       lower[i] = std::max(lower[i], gap);
       if (c.near || !(gap < settings.thickness)) return;
       lower[i] = start_geometry(i).distance;
-      cand_start_close[i] = cand_start[i].distance < settings.thickness && !redundant_on_flat_face_pair(c, cand_start[i], corner);
+      cand_start_close[i] = cand_start[i].distance < settings.thickness && !pairs.redundant_on_flat_face(c, cand_start[i], corner);
     };
     if (carried) {
       for_candidates(lin_bounds, motion, settings.thickness, visit);
@@ -1157,7 +779,7 @@ struct ContactStage::Impl {
   // Candidate i's geometry at the start of the step (computed once per step; each i by one thread).
   const PairGeometry& start_geometry(size_t i) {
     if (!cand_start_known[i]) {
-      cand_start[i] = geometry(potential_cands[i], corners(potential_cands[i], false));
+      cand_start[i] = pairs.geometry(potential_cands[i], corners(potential_cands[i], false));
       cand_start_known[i] = 1;
     }
     return cand_start[i];
@@ -1192,44 +814,6 @@ struct ContactStage::Impl {
   std::vector<PairGeometry> cand_start;  // per candidate, at the start of the step
   std::vector<char> cand_start_close;    // ... within the thickness there
 
-  // The largest gap along an axis between the boxes of a pair's two primitives (0 when they
-  // overlap): a lower bound of their distance [m].
-  static double box_gap(const std::array<Eigen::Vector3d, 4>& x, bool point_triangle) {
-    Eigen::Vector3d lo_a = x[0], hi_a = x[0], lo_b, hi_b;
-    if (point_triangle) {
-      lo_b = x[1].cwiseMin(x[2]).cwiseMin(x[3]);
-      hi_b = x[1].cwiseMax(x[2]).cwiseMax(x[3]);
-    } else {
-      lo_a = x[0].cwiseMin(x[1]);
-      hi_a = x[0].cwiseMax(x[1]);
-      lo_b = x[2].cwiseMin(x[3]);
-      hi_b = x[2].cwiseMax(x[3]);
-    }
-    return std::max(0.0, std::max((lo_b - hi_a).maxCoeff(), (lo_a - hi_b).maxCoeff()));
-  }
-  // Whether the two primitives of a pair (a point and a triangle's corners, or two edges' end
-  // points) have boxes closer than `reach` in every axis: otherwise their distance is at least that.
-  static bool within_boxes(const std::array<Eigen::Vector3d, 4>& x, bool point_triangle, double reach) {
-    return box_gap(x, point_triangle) <= reach;
-  }
-
-  // The pair's distance signed by the side it started on: a pair whose closest points are inside
-  // both primitives (a point over a triangle's interior, two edges at interior points) at the
-  // start and at the end of the step and whose normal turned against its start normal has passed
-  // through: its distance is negative and its normal the start side's, so the barrier pushes it
-  // back rather than through. (Where a closest point is on a primitive's boundary the normal can
-  // turn round an edge without a crossing; there the distance stays unsigned.)
-  static void sign_by_start(const PairGeometry& start, PairGeometry& end, bool point_triangle) {
-    if (!(end.normal.dot(start.normal) < 0)) return;
-    auto interior = [point_triangle](const PairGeometry& g) {
-      if (point_triangle) return -g.coef[1] > 0 && -g.coef[2] > 0 && -g.coef[3] > 0;
-      return g.coef[0] > 0 && g.coef[1] > 0 && g.coef[2] < 0 && g.coef[3] < 0;
-    };
-    if (!interior(start) || !interior(end)) return;
-    end.distance = -end.distance;
-    end.normal = -end.normal;
-  }
-
   // Lower bounds of the candidates' distances at a reference configuration, so that a pair whose
   // points have moved less than its bound allows is known to be apart without looking at it: the
   // step's start (p0 and the obstacles at t: start_bounds), or the end points of the last
@@ -1247,22 +831,11 @@ struct ContactStage::Impl {
   // 0.2 µm that had been 2 mm apart at rest). Computed once per candidate list, when first
   // needed (each index by one thread).
   std::vector<double> near_reach_of;
-  // The four points of a cloth–cloth pair (the only near pairs) in the rest state.
-  std::array<Eigen::Vector3d, 4> rest_corners(const Candidate& c) const {
-    auto rp = [&](int i) -> Eigen::Vector3d { return rest_points.row(i).transpose(); };
-    if (c.kind == Kind::cloth_edge_cloth_edge) {
-      const auto& ea = edges[static_cast<size_t>(c.a)];
-      const auto& eb = edges[static_cast<size_t>(c.b)];
-      return {rp(ea[0]), rp(ea[1]), rp(eb[0]), rp(eb[1])};
-    }
-    const auto& t = surface.triangles[static_cast<size_t>(c.b)];
-    return {rp(c.a), rp(t[0]), rp(t[1]), rp(t[2])};
-  }
   double near_reach(size_t i) {
     double& r = near_reach_of[i];
     if (r < 0.0) {
       const Candidate& c = potential_cands[i];
-      r = std::min(settings.thickness, 0.5 * geometry(c, rest_corners(c)).distance);
+      r = std::min(settings.thickness, 0.5 * pairs.geometry(c, pairs.corners(c, surf.rest_points(), surf.rest_points())).distance);
     }
     return r;
   }
@@ -1288,24 +861,6 @@ struct ContactStage::Impl {
   Eigen::MatrixX3d bound_to_points;   // ... and their end points
   Eigen::VectorXd point_move;       // scratch: per surface point, its move from the reference [m]
 
-  // How much a pair's distance can change when each of its cloth points p moves by at most
-  // move(p) and each obstacle vertex by at most `obstacle` [m] (the distance between two
-  // primitives changes by at most the largest move of a point of each).
-  double pair_motion(const Candidate& c, const Eigen::VectorXd& move, double obstacle) const {
-    const std::array<int, 4> q = cloth_points_of(c);
-    if (c.kind == Kind::cloth_point_cloth_triangle || c.kind == Kind::cloth_edge_cloth_edge) {
-      const size_t split = c.kind == Kind::cloth_point_cloth_triangle ? 1 : 2;
-      double a = 0.0, b = 0.0;
-      for (size_t k = 0; k < split; ++k) a = std::max(a, move(q[k]));
-      for (size_t k = split; k < 4; ++k) b = std::max(b, move(q[k]));
-      return a + b;
-    }
-    double largest = 0.0;
-    for (int p : q)
-      if (p >= 0) largest = std::max(largest, move(p));
-    return largest + obstacle;
-  }
-  // The reference for surface points `points` (and `other`, when not null: any move between the
   // two), with the obstacles where they are at the end of the step or, with `whole_step`, anywhere
   // over it: fills `point_move` with each point's largest distance from the reference, returns the
   // bounds, sets `obstacle` to the obstacles' largest move from theirs and `motion` to the
@@ -1340,7 +895,7 @@ struct ContactStage::Impl {
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p0.rows(), 1024), [&](const tbb::blocked_range<Eigen::Index>& range) {
       for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
         double sum = 0.0;
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(jacobian, 3 * p); it; ++it)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(surf.jacobian(), 3 * p); it; ++it)
           sum += it.value() * it.value() / scale(it.col() / 3);
         point_mass(p) = sum > 0 ? 1.0 / sum : std::numeric_limits<double>::infinity();
         plane_stiffness[static_cast<size_t>(p)] = barrier_ratio() * point_mass(p) / (h * h);
@@ -1362,36 +917,21 @@ struct ContactStage::Impl {
       if (!cand_start_close[i]) continue;
       const contact::CubicBarrier barrier{settings.thickness, pair_stiffness(potential_cands[i])};
       const PairGeometry& g = cand_start[i];
-      add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(g), -barrier.first(g.distance), [&] { return pair_row(g); });
+      add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(g), -barrier.first(g.distance), [&] { return surf.pair_row(g); });
     }
     for (int k : obs.planes) {
       const Obstacle& o = obstacles[static_cast<size_t>(k)];
       Eigen::Vector3d q0, n0;
       plane_at(o, t, q0, n0);
-      const RigidMap move = step_map(o, t);
+      const RigidMap move = contact::obstacle_step_map(o, t, h);
       for (Eigen::Index p = 0; p < p0.rows(); ++p) {
         const Eigen::Vector3d a = p0.row(p).transpose();
         const double dist = n0.dot(a - q0);
         if (!(dist < settings.thickness)) continue;
         const contact::CubicBarrier barrier{settings.thickness, plane_stiffness[static_cast<size_t>(p)]};
-        add_friction_row(n0, o.friction, -(move(a) - a) / h, -barrier.first(dist), [&] { return point_row(static_cast<int>(p)); });
+        add_friction_row(n0, o.friction, -(move(a) - a) / h, -barrier.first(dist), [&] { return surf.point_row(static_cast<int>(p)); });
       }
     }
-  }
-
-  // A constraint on one surface point (a plane's pair) with normal n.
-  Constraint point_constraint(int p, const Eigen::Vector3d& normal) {
-    PairGeometry g;
-    g.num = 1;
-    g.point[0] = p;
-    g.coef[0] = 1.0;
-    g.normal = normal;
-    return constraint(g);
-  }
-
-  // The row of one surface point (a plane's pair).
-  NodeRow point_row(int p) {
-    return point_rows_in_node_form ? point_rows[static_cast<size_t>(p)] : node_row(point_constraint(p, Eigen::Vector3d::UnitZ()));
   }
 
   // A lagged friction row for a pair with normal n, friction coefficient mu, the obstacle side's
@@ -1447,7 +987,7 @@ struct ContactStage::Impl {
     std::vector<PairGeometry>& end = end_geometry;
     for_candidates(bounds, motion, dhat, [&](size_t i) {
       const Candidate& c = potential_cands[i];
-      const double bound = bounds.lower[i] - pair_motion(c, point_move, obstacle_motion);
+      const double bound = bounds.lower[i] - pairs.motion(c, point_move, obstacle_motion);
       next.lower[i] = std::max(0.0, bound);
       if (bound >= dhat) return;
       const std::array<Eigen::Vector3d, 4> corner = corners(c, true);
@@ -1455,9 +995,9 @@ struct ContactStage::Impl {
       next.lower[i] = std::max(next.lower[i], gap);
       const double reach = c.near ? near_reach(i) : dhat;
       if (gap > reach) return;  // (most candidates: no exact distance)
-      end[i] = geometry(c, corner);
+      end[i] = pairs.geometry(c, corner);
       next.lower[i] = std::max(next.lower[i], end[i].distance);
-      if (redundant_on_flat_face_pair(c, end[i], corner)) return;
+      if (pairs.redundant_on_flat_face(c, end[i], corner)) return;
       if (end[i].distance < reach) sign_by_start(start_geometry(i), end[i], is_point_triangle(c.kind));
       active[i] = end[i].distance < reach;
     });
@@ -1483,14 +1023,14 @@ struct ContactStage::Impl {
     keep_closest(active, end);
     for (size_t i = 0; i < potential_cands.size(); ++i)
       if (active[i])
-        add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]),
+        add_pair(surf.pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]),
                  potential_cands[i].near ? near_reach(i) : dhat);
     for (int k : obs.planes) {
       Eigen::Vector3d q1, n1;
       plane_at(obstacles[static_cast<size_t>(k)], t + h, q1, n1);
       for (Eigen::Index p = 0; p < p1.rows(); ++p) {
         const double dist = n1.dot(p1.row(p).transpose() - q1);
-        if (dist < dhat) add_pair(point_row(static_cast<int>(p)), n1, dist, plane_stiffness[static_cast<size_t>(p)], dhat);
+        if (dist < dhat) add_pair(surf.point_row(static_cast<int>(p)), n1, dist, plane_stiffness[static_cast<size_t>(p)], dhat);
       }
     }
     const contact::SmoothedFriction friction{friction_epsilon()};
@@ -1530,7 +1070,7 @@ struct ContactStage::Impl {
     }
     // The obstacles stand where they are at the end of the step at both ends of the move.
     auto corner = [&](const Candidate& c, const Eigen::MatrixX3d& p) {
-      const std::array<int, 4> cloth = cloth_points_of(c);
+      const std::array<int, 4> cloth = pairs.cloth_points(c);
       std::array<Eigen::Vector3d, 4> x = corners(c, true);  // (obstacle points at t + h)
       // corners() puts the cloth points first for every kind but obstacle point–cloth triangle.
       if (c.kind == Kind::obstacle_point_cloth_triangle) {
@@ -1553,7 +1093,7 @@ struct ContactStage::Impl {
     auto visit = [&](size_t i) {
         const Candidate& c = (*cands)[i];
         double separation = c.near ? near_eta : eta;
-        if (lower != nullptr && (*lower)[i] - pair_motion(c, point_move, obstacle_motion) > separation) return;
+        if (lower != nullptr && (*lower)[i] - pairs.motion(c, point_move, obstacle_motion) > separation) return;
         const std::array<Eigen::Vector3d, 4> a = corner(c, pa), b = corner(c, pb);
         const bool pt = is_point_triangle(c.kind);
         // A quick reject: the boxes of the swept primitives farther apart than the separation.
@@ -1573,12 +1113,12 @@ struct ContactStage::Impl {
           hb = hb.cwiseMax(hi[k]);
         }
         if (!(((la.array() - separation) <= hb.array()).all() && ((lb.array() - separation) <= ha.array()).all())) return;
-        const double start_distance = geometry(c, a).distance;
+        const double start_distance = pairs.geometry(c, a).distance;
         if (!(start_distance > 0)) return;  // (touching already: nothing to bound)
         separation = std::min(separation, 0.5 * start_distance);
         // (A pair that does not move enough to lose what it has above the separation: most pairs
         // resting in contact between two Newton iterates.)
-        if (start_distance - pair_motion(c, step_move, 0.0) > separation) return;
+        if (start_distance - pairs.motion(c, step_move, 0.0) > separation) return;
         const contact::CcdResult r = pt ? contact::point_triangle_ccd(a, b, separation) : contact::edge_edge_ccd(a, b, separation);
         if (r.hit) bound[i] = r.toi;
     };
@@ -1616,9 +1156,7 @@ struct ContactStage::Impl {
   // The surface points and obstacle vertices at the start of the step (and the obstacles' at its
   // end); the end points are to be made from the velocities.
   void start_positions(const Eigen::VectorXd& x, double t) {
-    const Eigen::MatrixX3d net = d.control_net(x);
-    p0.resize(surface.position.rows(), 3);
-    parallel_product(surface.position, net.data(), net.rows(), 3, p0.data());
+    p0 = surf.points(x);
     end_points_current = false;
     const bool placed = obstacles_static && o0.rows() == static_cast<Eigen::Index>(obs.obstacle_of_vertex.size());
     if (!placed) obstacle_boxes_current = false;
@@ -1776,7 +1314,7 @@ ContactReport ContactStage::filter(const Eigen::VectorXd& x, double t, double h,
 
 void ContactStage::enable_potential() {
   impl_->potential_on = true;
-  impl_->make_point_rows();
+  impl_->surf.make_point_rows();
 }
 bool ContactStage::potential_enabled() const { return impl_->potential_on; }
 
@@ -1806,7 +1344,7 @@ double ContactStage::velocity_tolerance(double h) const {
   return 0.01 * impl_->settings.tolerance * impl_->settings.thickness / h;
 }
 
-const SurfaceOperator& ContactStage::surface() const { return impl_->surface; }
+const SurfaceOperator& ContactStage::surface() const { return impl_->surf.op(); }
 long long ContactStage::joined_at_rest() const { return impl_->joined_pairs; }
 const std::vector<Obstacle>& ContactStage::obstacles() const { return impl_->obstacles; }
 
