@@ -216,14 +216,12 @@ struct ContactStage::Impl {
     return out;
   }
   // Pairs whose distance may fall below the minimum separation during the step (CCD), with their
-  // geometry at the (conservative) time of impact.
-  // Pairs whose distance may fall below the minimum separation during the step. With `moved`
-  // (per surface point: its end position changed since the last test) and `last` (the pairs
-  // that collided then, sorted), only pairs with a moved point or a previous collision are
-  // tested again: the others have the same positions, so the same (negative) answer. With
-  // `bounds` (the potential's candidates' distance bounds at a reference, from reference_bounds,
-  // which fills point_move and gives `motion`), pairs that cannot come within the separation are
-  // not tested.
+  // geometry at the (conservative) time of impact. With `moved` (per surface point: its end
+  // position changed since the last test) and `last` (the pairs that collided then, sorted), only
+  // pairs with a moved point or a previous collision are tested again: the others have the same
+  // positions, so the same (negative) answer. With `bounds` (the potential's candidates' distance
+  // bounds at a reference, from reference_bounds, which fills point_move and gives `motion`),
+  // pairs that cannot come within the separation are not tested.
   std::vector<Found> collisions(const std::vector<Candidate>& cands, double t, ContactReport& report,
                                 const std::vector<char>* moved = nullptr, const std::vector<Candidate>* last = nullptr,
                                 std::vector<Candidate>* hit_pairs = nullptr, const Bounds* bounds = nullptr,
