@@ -70,9 +70,9 @@ Eigen::MatrixX3d CollisionSurface::end_points(const Eigen::MatrixX3d& p0, double
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p0.rows(), 2048), [&](const tbb::blocked_range<Eigen::Index>& range) {
       for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
         double x = 0.0, y = 0.0, z = 0.0;
-        for (int k = point_offsets_[static_cast<size_t>(p)]; k < point_offsets_[static_cast<size_t>(p) + 1]; ++k) {
-          const double w = point_weights_[static_cast<size_t>(k)];
-          const double* vn = v.data() + 3 * static_cast<Eigen::Index>(point_nodes_[static_cast<size_t>(k)]);
+        for (int k = point_map_.offsets[static_cast<size_t>(p)]; k < point_map_.offsets[static_cast<size_t>(p) + 1]; ++k) {
+          const double w = point_map_.weights[static_cast<size_t>(k)];
+          const double* vn = v.data() + 3 * static_cast<Eigen::Index>(point_map_.nodes[static_cast<size_t>(k)]);
           x += w * vn[0];
           y += w * vn[1];
           z += w * vn[2];
@@ -164,16 +164,34 @@ void CollisionSurface::make_point_rows() {
     std::sort(row.nodes.begin(), row.nodes.end());
     point_rows_[static_cast<size_t>(p)] = std::move(row);
   }
-  point_offsets_.assign(1, 0);
-  point_nodes_.clear();
-  point_weights_.clear();
+  point_map_ = PointMap{};
   for (const NodeRow& row : point_rows_) {
     for (const auto& [node, w] : row.nodes) {
-      point_nodes_.push_back(node);
-      point_weights_.push_back(w);
+      point_map_.nodes.push_back(node);
+      point_map_.weights.push_back(w);
     }
-    point_offsets_.push_back(static_cast<int>(point_nodes_.size()));
+    point_map_.offsets.push_back(static_cast<int>(point_map_.nodes.size()));
   }
+}
+
+PointRow CollisionSurface::pair_points(const PairGeometry& g) const {
+  PointRow row;
+  for (int k = 0; k < g.num; ++k) {
+    const double coef = g.coef[static_cast<size_t>(k)];
+    if (g.obstacle[static_cast<size_t>(k)] || coef == 0.0) continue;
+    row.points[static_cast<size_t>(row.count)] = g.point[static_cast<size_t>(k)];
+    row.coefs[static_cast<size_t>(row.count)] = coef;
+    ++row.count;
+  }
+  return row;
+}
+
+PointRow CollisionSurface::point_alone(int p) const {
+  PointRow row;
+  row.points[0] = p;
+  row.coefs[0] = 1.0;
+  row.count = 1;
+  return row;
 }
 
 NodeRow CollisionSurface::point_row(int p) {

@@ -83,6 +83,12 @@ class CollisionSurface {
   NodeRow point_row(int p);
   // The row of a pair's relative position over the nodes, Σ_k c_k J_k (cloth points only).
   NodeRow pair_row(const PairGeometry& g);
+  // The same rows on the points (sim/solver/coupled_matrix.hpp), through point_map(): J's rows in
+  // node form (nullptr when they are not, see make_point_rows). A pair's row on its cloth points
+  // with a coefficient other than 0, and the row of point p alone.
+  const PointMap* point_map() const { return in_node_form_ ? &point_map_ : nullptr; }
+  PointRow pair_points(const PairGeometry& g) const;
+  PointRow point_alone(int p) const;
 
   // Whether fine triangles a and b are within `near` [m] of each other at rest: sharing a vertex,
   // two vertices closer than `near`, or else their exact distance below it.
@@ -110,8 +116,7 @@ class CollisionSurface {
   // The point rows (make_point_rows), and the same packed (CSR) for end_points.
   std::vector<NodeRow> point_rows_;
   bool in_node_form_ = false;
-  std::vector<int> point_offsets_, point_nodes_;
-  std::vector<double> point_weights_;
+  PointMap point_map_;
 };
 
 }  // namespace clothsim::contact

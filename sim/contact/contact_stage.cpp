@@ -288,10 +288,49 @@ struct ContactStage::Impl {
   double potential_t = 0.0;
   std::vector<Candidate> potential_cands;   // this step's candidates (boxes grown by 2 d̂)
   Eigen::MatrixX3d potential_guess;         // the end points they were made for
-  std::vector<double> plane_stiffness;      // per surface point, against planes [N/m]
-  Eigen::VectorXd point_mass;               // per surface point: 1 / Σ_k J_k² / s_k [kg]
+  // A row of the potential: on the surface's points where J's rows are in node form (so the
+  // integrator applies it without merging the points' stencils), else over the DOFs.
+  struct Row {
+    PointRow points;
+    NodeRow dofs;
+    Eigen::Vector3d apply(const contact::CollisionSurface& surf, const Eigen::VectorXd& v) const {
+      return points.count > 0 ? points.apply(*surf.point_map(), v) : dofs.apply(v);
+    }
+    void scatter(const contact::CollisionSurface& surf, const Eigen::Vector3d& f, Eigen::VectorXd& y) const {
+      if (points.count > 0) {
+        points.scatter(*surf.point_map(), f, y);
+      } else {
+        dofs.scatter(f, y);
+      }
+    }
+    void put_in(PotentialLinearisation::Block& block) const {
+      if (points.count > 0) {
+        block.on_points = points;
+      } else {
+        block.row = dofs;
+      }
+    }
+  };
+  Row pair_row(const PairGeometry& g) {
+    Row r;
+    if (surf.point_map() != nullptr) {
+      r.points = surf.pair_points(g);
+    } else {
+      r.dofs = surf.pair_row(g);
+    }
+    return r;
+  }
+  Row point_row(int p) {
+    Row r;
+    if (surf.point_map() != nullptr) {
+      r.points = surf.point_alone(p);
+    } else {
+      r.dofs = surf.point_row(p);
+    }
+    return r;
+  }
   struct FrictionRow {
-    NodeRow row;
+    Row row;
     Eigen::Vector3d constant = Eigen::Vector3d::Zero();  // the obstacle side's part of u [m/s]
     Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity();
     double bound = 0.0;  // μ λ [N]
@@ -325,12 +364,35 @@ struct ContactStage::Impl {
   // The barrier's stiffness for a pair of cloth points: k h² = ratio × the smallest effective
   // mass (with the step's stiffness, s_k) of its cloth points, so the barrier is as stiff as the
   // step's own system is under it, whatever the material and step.
-  double pair_stiffness(const Candidate& c) const {
+  double pair_stiffness(const Candidate& c) {
     double m = std::numeric_limits<double>::infinity();
     for (int p : pairs.cloth_points(c))
-      if (p >= 0) m = std::min(m, point_mass(p));
+      if (p >= 0) m = std::min(m, mass_of_point(p));
     return barrier_ratio() * m / (h * h);
   }
+  // Effective mass of surface point p through J, 1 / Σ_k J_k² / s_k, with each node's scale s_k
+  // the mean of its three diagonal entries of A (a rotation leaves the trace of a node's block
+  // unchanged). Made on first use in a step (few points are in pairs; all of them took a quarter
+  // of a millisecond per step on the 494-vertex sleeve); not for parallel callers.
+  Eigen::VectorXd node_scale;           // s_k of this step
+  Eigen::VectorXd point_mass;           // per surface point [kg], NaN until made in this step
+  double mass_of_point(int p) {
+    double& m = point_mass(p);
+    if (!std::isnan(m)) return m;
+    double sum = 0.0;
+    if (const PointMap* map = surf.point_map()) {
+      for (int e = map->offsets[static_cast<size_t>(p)]; e < map->offsets[static_cast<size_t>(p) + 1]; ++e) {
+        const double w = map->weights[static_cast<size_t>(e)];
+        sum += w * w / node_scale(map->nodes[static_cast<size_t>(e)]);
+      }
+    } else {
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(surf.jacobian(), 3 * p); it; ++it)
+        sum += it.value() * it.value() / node_scale(it.col() / 3);
+    }
+    m = sum > 0 ? 1.0 / sum : std::numeric_limits<double>::infinity();
+    return m;
+  }
+  double plane_stiffness(int p) { return barrier_ratio() * mass_of_point(p) / (h * h); }
 
   // The potential's candidates: the broad phase over the motion p0 → p1 with boxes grown by twice
   // the thickness. They serve every configuration, and every motion between two, whose points
@@ -554,21 +616,10 @@ struct ContactStage::Impl {
     end_points_current = false;
     update_end_points(v_guess);
     p1_velocity = v_guess;
-    // Effective masses of the surface points through J, with each node's scale s_k the mean of
-    // its three diagonal entries of A (a rotation leaves the trace of a node's block unchanged).
-    Eigen::VectorXd scale(d.num_nodes());
-    for (int k = 0; k < d.num_nodes(); ++k) scale(k) = diagonal.segment<3>(3 * k).sum() / 3.0;
-    point_mass.resize(p0.rows());
-    plane_stiffness.resize(static_cast<size_t>(p0.rows()));
-    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p0.rows(), 1024), [&](const tbb::blocked_range<Eigen::Index>& range) {
-      for (Eigen::Index p = range.begin(); p != range.end(); ++p) {
-        double sum = 0.0;
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(surf.jacobian(), 3 * p); it; ++it)
-          sum += it.value() * it.value() / scale(it.col() / 3);
-        point_mass(p) = sum > 0 ? 1.0 / sum : std::numeric_limits<double>::infinity();
-        plane_stiffness[static_cast<size_t>(p)] = barrier_ratio() * point_mass(p) / (h * h);
-      }
-    });
+    // (The surface points' effective masses are made when a pair needs them: mass_of_point.)
+    node_scale.resize(d.num_nodes());
+    for (int k = 0; k < d.num_nodes(); ++k) node_scale(k) = diagonal.segment<3>(3 * k).sum() / 3.0;
+    point_mass.setConstant(p0.rows(), std::numeric_limits<double>::quiet_NaN());
     ContactReport scratch;
     check_obstacles_serve();
     served_known = false;  // (a new start)
@@ -585,7 +636,7 @@ struct ContactStage::Impl {
       if (!cand_start_close[i]) continue;
       const contact::CubicBarrier barrier{settings.thickness, pair_stiffness(potential_cands[i])};
       const PairGeometry& g = cand_start[i];
-      add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(g), -barrier.first(g.distance), [&] { return surf.pair_row(g); });
+      add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(g), -barrier.first(g.distance), [&] { return pair_row(g); });
     }
     for (int k : obs.planes) {
       const Obstacle& o = obstacles[static_cast<size_t>(k)];
@@ -596,8 +647,8 @@ struct ContactStage::Impl {
         const Eigen::Vector3d a = p0.row(p).transpose();
         const double dist = n0.dot(a - q0);
         if (!(dist < settings.thickness)) continue;
-        const contact::CubicBarrier barrier{settings.thickness, plane_stiffness[static_cast<size_t>(p)]};
-        add_friction_row(n0, o.friction, -(move(a) - a) / h, -barrier.first(dist), [&] { return surf.point_row(static_cast<int>(p)); });
+        const contact::CubicBarrier barrier{settings.thickness, plane_stiffness(static_cast<int>(p))};
+        add_friction_row(n0, o.friction, -(move(a) - a) / h, -barrier.first(dist), [&] { return point_row(static_cast<int>(p)); });
       }
     }
   }
@@ -675,12 +726,13 @@ struct ContactStage::Impl {
     lin_velocity = v;
     lin_time = t + h;
     lin_bounds_valid = true;
-    auto add_pair = [&](NodeRow row, const Eigen::Vector3d& normal, double distance, double k, double reach) {
+    out.point_map = surf.point_map();
+    auto add_pair = [&](const Row& row, const Eigen::Vector3d& normal, double distance, double k, double reach) {
       const contact::CubicBarrier barrier{reach, k};
       out.energy += barrier.value(distance);
       PotentialLinearisation::Block block;
-      block.row = std::move(row);
-      block.row.scatter(barrier.first(distance) * normal, out.energy_gradient);
+      row.put_in(block);
+      row.scatter(surf, barrier.first(distance) * normal, out.energy_gradient);
       block.hessian = barrier.second(distance) * normal * normal.transpose();
       out.blocks.push_back(std::move(block));
       ++out.active;
@@ -691,23 +743,23 @@ struct ContactStage::Impl {
     keep_closest(active, end);
     for (size_t i = 0; i < potential_cands.size(); ++i)
       if (active[i])
-        add_pair(surf.pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]),
+        add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(potential_cands[i]),
                  potential_cands[i].near ? near_reach(i) : dhat);
     for (int k : obs.planes) {
       Eigen::Vector3d q1, n1;
       plane_at(obstacles[static_cast<size_t>(k)], t + h, q1, n1);
       for (Eigen::Index p = 0; p < p1.rows(); ++p) {
         const double dist = n1.dot(p1.row(p).transpose() - q1);
-        if (dist < dhat) add_pair(surf.point_row(static_cast<int>(p)), n1, dist, plane_stiffness[static_cast<size_t>(p)], dhat);
+        if (dist < dhat) add_pair(point_row(static_cast<int>(p)), n1, dist, plane_stiffness(static_cast<int>(p)), dhat);
       }
     }
     const contact::SmoothedFriction friction{friction_epsilon()};
     for (const FrictionRow& f : friction_rows) {
-      const Eigen::Vector3d w = f.tangent * (f.row.apply(v) + f.constant);
+      const Eigen::Vector3d w = f.tangent * (f.row.apply(surf, v) + f.constant);
       out.dissipation += f.bound * friction.f0(w.norm());
-      f.row.scatter(friction.gradient(w, f.bound), out.dissipation_gradient);
+      f.row.scatter(surf, friction.gradient(w, f.bound), out.dissipation_gradient);
       PotentialLinearisation::Block block;
-      block.row = f.row;
+      f.row.put_in(block);
       block.hessian = friction.hessian(w, f.tangent, f.bound);
       block.dissipative = true;
       out.blocks.push_back(std::move(block));

@@ -244,7 +244,7 @@ class ImplicitEuler {
   // velocity at the start of the step; a and b are the elastic system. `first`: the step's first
   // linearisation of the elastic terms (the potential starts its step; later ones continue from
   // v, already free of crossings). Sets potential_acted_ where the potential is something.
-  LinearSolveReport solve_with_potential(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
+  LinearSolveReport solve_with_potential(Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
                                          const Eigen::VectorXd& v_now, double t, double h, bool first, Eigen::VectorXd& v,
                                          StepStats& stats);
   // Ends the potential's step at the accepted velocities v.

@@ -36,6 +36,18 @@ struct PotentialLinearisation {
   };
   std::vector<Block> blocks;
   const PointMap* point_map = nullptr;  // the points of the blocks on points (the potential's own)
+  // A block's row in either form: u = B x, y += Bᵀ f, and B in node form.
+  Eigen::Vector3d apply(const Block& b, const Eigen::VectorXd& x) const {
+    return b.is_on_points() ? b.on_points.apply(*point_map, x) : b.row.apply(x);
+  }
+  void scatter(const Block& b, const Eigen::Vector3d& f, Eigen::VectorXd& y) const {
+    if (b.is_on_points()) {
+      b.on_points.scatter(*point_map, f, y);
+    } else {
+      b.row.scatter(f, y);
+    }
+  }
+  NodeRow node_row(const Block& b) const { return b.is_on_points() ? b.on_points.node_row(*point_map) : b.row; }
   int active = 0;  // active pairs (barrier) this linearisation holds
   bool empty() const { return blocks.empty() && energy == 0.0 && dissipation == 0.0; }
 };

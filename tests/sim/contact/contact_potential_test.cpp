@@ -103,7 +103,7 @@ TEST(ContactPotential, GradientsAndHessianMatchFiniteDifferences) {
     // Hessians: d(∇ₓE)/dv · dir = h ∇²ₓE dir and d(∇ᵥΨ)/dv · dir = ∇²ᵥΨ dir, with ∇² = Σ Bᵀ H B.
     Eigen::VectorXd stiffness = Eigen::VectorXd::Zero(n3), damping = Eigen::VectorXd::Zero(n3);
     for (const PotentialLinearisation::Block& b : lin.blocks)
-      b.row.scatter(b.hessian * b.row.apply(dir), b.dissipative ? damping : stiffness);
+      lin.scatter(b, b.hessian * lin.apply(b, dir), b.dissipative ? damping : stiffness);
     const Eigen::VectorXd fd_stiffness = (plus.energy_gradient - minus.energy_gradient) / (2 * eps);
     const Eigen::VectorXd fd_damping = (plus.dissipation_gradient - minus.dissipation_gradient) / (2 * eps);
     EXPECT_LE((fd_stiffness - f.h * stiffness).norm(), 1e-5 * (f.h * stiffness).norm()) << "trial " << trial;
