@@ -142,68 +142,43 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
   constexpr int kMaxNewton = 12;
   int iterations = 0;
   for (;;) {
-    // Blocks on one row (a surface point's barrier and its friction, or its pairs with two
-    // obstacles) are added as one, weighted: a block's matrix work grows with the square of its
-    // row's nodes (a quarter of sheet_fall's run when each resting point added two).
-    merged_.clear();
-    merged_index_.clear();
-    for (const PotentialLinearisation::Block& block : lin.blocks) {
-      const double weight = block.dissipative ? h : h * h;
-      const auto [at, inserted] = merged_index_.try_emplace(&block, merged_.size());
-      if (inserted) {
-        merged_.emplace_back(&block, weight * block.hessian);
-      } else {
-        merged_[at->second].second += weight * block.hessian;
-      }
-    }
+    // The potential's blocks, weighted by h² (energy) or h (dissipation), merged by row
+    // (sim/solver/block_sum.hpp).
+    blocks_.build(lin, h);
     // The Newton matrix A + Σ Bᵀ (h² H) B. Its blocks each couple every node of their rows' stencils
     // (12–50 nodes per pair on a level-2 surface), so with the conjugate-gradient solver it is applied
     // as A x + Σ Bᵀ (h² H (B x)) and assembled only when the preconditioner needs a new factor (the
     // crushed sleeve's step with 1,500 active pairs: the assembly cost more than the rest of the step).
     // The pattern: A's and the couplings of the blocks; rebuilt only when a block needs a coupling it
     // lacks (then the solver analyses the new pattern).
-    // Rows on points are put in node form only here (a cloth–cloth pair's merges 4 points' stencils).
-    const PointMap* points = lin.point_map;
     auto assemble = [&]() -> Eigen::SparseMatrix<double>& {
-      std::vector<NodeRow> on_points;  // (the node form of the rows on points, in merged_'s order)
-      for (const auto& [block, hw] : merged_)
-        if (block->is_on_points()) on_points.push_back(block->on_points.node_row(*points));
+      const std::vector<std::pair<NodeRow, Eigen::Matrix3d>> node_blocks = blocks_.node_blocks();
       std::vector<std::vector<int>> groups;
-      groups.reserve(merged_.size());
-      size_t k = 0;
-      for (const auto& [block, hw] : merged_) groups.push_back((block->is_on_points() ? on_points[k++] : block->row).node_list());
+      groups.reserve(node_blocks.size());
+      for (const auto& [row, hw] : node_blocks) groups.push_back(row.node_list());
       std::sort(groups.begin(), groups.end());  // (many rows share their nodes: each list is checked once)
       groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
       if (!coupled_.covers(a, groups)) coupled_.rebuild(a, groups, /*keep_previous=*/true);
       coupled_.set_base(a);
-      k = 0;
-      for (const auto& [block, hw] : merged_) coupled_.add_block(block->is_on_points() ? on_points[k++] : block->row, hw);
+      for (const auto& [row, hw] : node_blocks) coupled_.add_block(row, hw);
       coupled_in_use_ = true;
       return coupled_.matrix();
     };
-    auto apply = [&lin](const Block& block, const Eigen::VectorXd& w) { return lin.apply(block, w); };
-    auto scatter = [&lin](const Block& block, const Eigen::Vector3d& f, Eigen::VectorXd& y) { lin.scatter(block, f, y); };
     rhs = b;
     Eigen::VectorXd hv = Eigen::VectorXd::Zero(n3);  // (h² ∇²E + h ∇²Ψ) v
-    double row_entries = 0.0;
-    for (const auto& [block, hw] : merged_) {
-      scatter(*block, hw * apply(*block, v), hv);
-      const int entries = block->is_on_points() ? block->on_points.entries(*points)
-                                                : static_cast<int>(block->row.nodes.size() + block->row.dofs.size());
-      row_entries += 6.0 * entries;
-    }
+    blocks_.add_product(v, hv);
     if (lin.energy_gradient.size() == n3) rhs -= h * lin.energy_gradient;
     if (lin.dissipation_gradient.size() == n3) rhs -= h * lin.dissipation_gradient;
     rhs += hv;
     v_new = v;
     LinearSolveReport r;
-    if (!merged_.empty() && solver_.solves_operators()) {
+    if (!blocks_.empty() && solver_.solves_operators()) {
       const LinearOperator newton_product = [&](const Eigen::VectorXd& w, Eigen::VectorXd& y) {
         symmetric_product(a, w, ones, y);
-        for (const auto& [block, hw] : merged_) scatter(*block, hw * apply(*block, w), y);
+        blocks_.add_product(w, y);
       };
-      r = solver_.solve(newton_product, static_cast<double>(a.nonZeros()) + row_entries, assemble, rhs, free_, v_new);
-    } else if (merged_.empty() && solver_.solves_operators() && (coupled_.empty() || coupled_.matrix().nonZeros() == a.nonZeros())) {
+      r = solver_.solve(newton_product, static_cast<double>(a.nonZeros()) + blocks_.product_entries(), assemble, rhs, free_, v_new);
+    } else if (blocks_.empty() && solver_.solves_operators() && (coupled_.empty() || coupled_.matrix().nonZeros() == a.nonZeros())) {
       // No blocks, and no couplings in the pattern: A itself (the conjugate-gradient solver leaves
       // it as it is), without copying its values (a quarter of a millisecond per step on the
       // 494-vertex sleeve).
@@ -281,27 +256,6 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
   stats.contact.ms += potential_ms;
   stats.solve_ms -= potential_ms;  // (the caller times the whole call as the solve)
   return total;
-}
-
-size_t ImplicitEuler::RowHash::operator()(const Block* b) const {
-  size_t seed = 0;
-  auto mix = [&seed](size_t v) { seed ^= v + 0x9e3779b97f4a7c15ULL + (seed << 6) + (seed >> 2); };
-  if (b->is_on_points()) {
-    mix(static_cast<size_t>(b->on_points.count) + 1000003);
-    for (int k = 0; k < b->on_points.count; ++k) {
-      mix(std::hash<int>{}(b->on_points.points[static_cast<size_t>(k)]));
-      mix(std::hash<double>{}(b->on_points.coefs[static_cast<size_t>(k)]));
-    }
-    return seed;
-  }
-  const NodeRow* r = &b->row;
-  seed = r->nodes.size() * 31 + r->dofs.size();
-  for (const auto& [node, w] : r->nodes) {
-    mix(std::hash<int>{}(node));
-    mix(std::hash<double>{}(w));
-  }
-  for (const auto& [dof, v] : r->dofs) mix(std::hash<int>{}(dof));
-  return seed;
 }
 
 void ImplicitEuler::finish_potential(const Eigen::VectorXd& v, StepStats& stats) {

@@ -23,6 +23,7 @@
 
 #include "sim/integrator/scripted_boundary.hpp"
 #include "sim/core/contact_counters.hpp"
+#include "sim/solver/block_sum.hpp"
 #include "sim/solver/step_potential.hpp"
 #include "sim/discretization/discretization.hpp"
 #include "sim/core/force_term.hpp"
@@ -34,7 +35,6 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -254,21 +254,8 @@ class ImplicitEuler {
   void end_positions(const Eigen::VectorXd& x, const Eigen::VectorXd& v, const Eigen::VectorXd& target,
                      Eigen::VectorXd& x_end, Eigen::VectorXd& u_end) const;
   bool potential_acted_ = false;  // the step potential was something in this step's Newton iterates
-  // Scratch of solve_with_potential: the linearisation's blocks merged by row (first occurrence
-  // order), weighted by the integrator's h² or h.
-  // (Blocks are keyed by their row, in node form or on points.)
-  using Block = PotentialLinearisation::Block;
-  struct RowHash {
-    size_t operator()(const Block* b) const;
-  };
-  struct RowEqual {
-    bool operator()(const Block* a, const Block* b) const {
-      if (a->is_on_points() || b->is_on_points()) return a->on_points == b->on_points;
-      return a->row.nodes == b->row.nodes && a->row.dofs == b->row.dofs;
-    }
-  };
-  std::vector<std::pair<const Block*, Eigen::Matrix3d>> merged_;
-  std::unordered_map<const Block*, size_t, RowHash, RowEqual> merged_index_;
+  // Scratch of solve_with_potential: the linearisation's blocks, merged by row and weighted.
+  BlockSum blocks_;
   bool contact_last_step_ = false;  // ... in the last step's (the next step's Newton starts from v)
 };
 
