@@ -36,7 +36,7 @@ struct Candidate {
 };
 
 // Lower bounds of the distances of a list of candidate pairs at some configuration
-// (ContactStage::Impl::reference_bounds), and those below a reach.
+// (BarrierPotential::reference_bounds, sim/contact/barrier_potential.hpp), and those below a reach.
 struct Bounds {
   std::vector<double> lower;    // per candidate [m]
   std::vector<size_t> close;    // the candidates whose bound is below `reach`

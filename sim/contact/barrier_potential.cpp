@@ -1,0 +1,577 @@
+#include "sim/contact/barrier_potential.hpp"
+
+#include "sim/contact/narrow_phase.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+namespace clothsim::contact {
+
+BarrierPotential::BarrierPotential(CollisionSurface& surface, const PairPrimitives& pairs, const ObstacleSet& obstacle_set,
+                                   const std::vector<Obstacle>& obstacles, CandidateSearch& search,
+                                   const BarrierSettings& settings)
+    : surf_(surface), pairs_(pairs), obs_(obstacle_set), obstacles_(obstacles), search_(search), settings_(settings) {}
+
+// --- Rows --------------------------------------------------------------------------------------
+Eigen::Vector3d BarrierPotential::Row::apply(const CollisionSurface& surf, const Eigen::VectorXd& v) const {
+  return points.count > 0 ? points.apply(*surf.point_map(), v) : dofs.apply(v);
+}
+void BarrierPotential::Row::scatter(const CollisionSurface& surf, const Eigen::Vector3d& f, Eigen::VectorXd& y) const {
+  if (points.count > 0) {
+    points.scatter(*surf.point_map(), f, y);
+  } else {
+    dofs.scatter(f, y);
+  }
+}
+void BarrierPotential::Row::put_in(PotentialLinearisation::Block& block) const {
+  if (points.count > 0) {
+    block.on_points = points;
+  } else {
+    block.row = dofs;
+  }
+}
+BarrierPotential::Row BarrierPotential::pair_row(const PairGeometry& g) {
+  Row r;
+  if (surf_.point_map() != nullptr) {
+    r.points = surf_.pair_points(g);
+  } else {
+    r.dofs = surf_.pair_row(g);
+  }
+  return r;
+}
+BarrierPotential::Row BarrierPotential::point_row(int p) {
+  Row r;
+  if (surf_.point_map() != nullptr) {
+    r.points = surf_.point_alone(p);
+  } else {
+    r.dofs = surf_.point_row(p);
+  }
+  return r;
+}
+
+// The end points p0 + h J v (#P × 3) for velocities v.
+Eigen::MatrixX3d BarrierPotential::end_points_of(const StepPositions& step, const Eigen::VectorXd& v) const {
+  return surf_.end_points(step.p0, h_, v);
+}
+
+// The obstacle side's part of a pair's relative velocity over the step [m/s].
+Eigen::Vector3d BarrierPotential::obstacle_side_velocity(const StepPositions& step, const PairGeometry& g) const {
+  Eigen::Vector3d u = Eigen::Vector3d::Zero();
+  for (int k = 0; k < g.num; ++k)
+    if (g.obstacle[static_cast<size_t>(k)]) {
+      const int p = g.point[static_cast<size_t>(k)];
+      u += g.coef[static_cast<size_t>(k)] * (step.o1.row(p) - step.o0.row(p)).transpose() / h_;
+    }
+  return u;
+}
+double BarrierPotential::pair_friction(const PairGeometry& g) const {
+  const int o = pairs_.obstacle_of(g);
+  return o >= 0 ? obstacles_[static_cast<size_t>(o)].friction : settings_.friction;
+}
+
+// --- Stiffness ---------------------------------------------------------------------------------
+// The barrier's stiffness for a pair of cloth points: k h² = ratio × the smallest effective mass
+// (with the step's stiffness, s_k) of its cloth points, so the barrier is as stiff as the step's
+// own system is under it, whatever the material and step.
+double BarrierPotential::pair_stiffness(const Candidate& c) {
+  double m = std::numeric_limits<double>::infinity();
+  for (int p : pairs_.cloth_points(c))
+    if (p >= 0) m = std::min(m, mass_of_point(p));
+  return settings_.barrier_ratio * m / (h_ * h_);
+}
+// Effective mass of surface point p through J, 1 / Σ_k J_k² / s_k, with each node's scale s_k the
+// mean of its three diagonal entries of A (a rotation leaves the trace of a node's block
+// unchanged). Made on first use in a step (few points are in pairs; all of them took a quarter of
+// a millisecond per step on the 494-vertex sleeve); not for parallel callers.
+double BarrierPotential::mass_of_point(int p) {
+  double& m = point_mass_(p);
+  if (!std::isnan(m)) return m;
+  double sum = 0.0;
+  if (const PointMap* map = surf_.point_map()) {
+    for (int e = map->offsets[static_cast<size_t>(p)]; e < map->offsets[static_cast<size_t>(p) + 1]; ++e) {
+      const double w = map->weights[static_cast<size_t>(e)];
+      sum += w * w / node_scale_(map->nodes[static_cast<size_t>(e)]);
+    }
+  } else {
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(surf_.jacobian(), 3 * p); it; ++it)
+      sum += it.value() * it.value() / node_scale_(it.col() / 3);
+  }
+  m = sum > 0 ? 1.0 / sum : std::numeric_limits<double>::infinity();
+  return m;
+}
+double BarrierPotential::plane_stiffness(int p) { return settings_.barrier_ratio * mass_of_point(p) / (h_ * h_); }
+
+// --- Candidates and when they serve ------------------------------------------------------------
+// The potential's candidates: the broad phase over the motion p0 → p1 with boxes grown by twice
+// the thickness. They serve every configuration, and every motion between two, whose points (and
+// obstacle vertices) each stay within half the thickness of the straight path from the start to
+// the end point they were made for: at any time of such a motion every point is within that of
+// its swept box, so each pair that comes within the thickness at the end (the barrier), over the
+// step (the fail-safe's CCD) or over a Newton step (step_bound) is among them. So they are kept
+// from step to step while the cloth moves little (a resting drape), and from the held start to
+// the guess and on through Newton's iterates within a step.
+// (serve_radius is half the thickness. A radius of 1 or 2.5 thicknesses took 2.2 or 9.6 times the
+// contact time on sleeve_on_arm's first 0.6 s: the candidates grow faster than their rebuilds get
+// rarer.)
+
+// The largest distance of a point p_i from the segment a_i → b_i [m] (infinite for other sizes).
+double BarrierPotential::sweep_distance(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+  if (p.rows() != a.rows() || p.rows() != b.rows()) return std::numeric_limits<double>::infinity();
+  if (p.rows() == 0) return 0.0;
+  // (Column by column, so that it vectorises: it runs several times per step.)
+  const Eigen::ArrayX3d d = (b - a).array(), q = (p - a).array();
+  const Eigen::ArrayXd dd = d.square().rowwise().sum();
+  const Eigen::ArrayXd s = (dd > 0).select(((q * d).rowwise().sum() / dd).max(0.0).min(1.0), 0.0);
+  return std::sqrt((q - d.colwise() * s).square().rowwise().sum().maxCoeff());
+}
+
+bool BarrierPotential::serves(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d* q) const {
+  const double r = serve_radius();
+  return obstacles_serve_ && sweep_distance(p, built_p0_, guess_) <= r &&
+         (q == nullptr || sweep_distance(*q, built_p0_, guess_) <= r);
+}
+
+// (The step bound's end of a move is the next linearisation's point, and its start the last
+// one's: the check is a few passes over all surface points, and it runs several times a step.)
+bool BarrierPotential::served(const Eigen::VectorXd& v, const Eigen::MatrixX3d& p) {
+  if (!obstacles_serve_) return false;
+  if (served_known_ && v.size() == served_velocity_.size() && v == served_velocity_) return true;
+  if (!(sweep_distance(p, built_p0_, guess_) <= serve_radius())) return false;
+  served_velocity_ = v;
+  served_known_ = true;
+  return true;
+}
+
+void BarrierPotential::check_obstacles_serve(const StepPositions& step) {
+  if (settings_.obstacles_static && built_o0_.rows() == step.o0.rows()) {  // (o0 = o1 = built_o0 = built_o1)
+    obstacles_serve_ = true;
+    return;
+  }
+  const double r = serve_radius();
+  obstacles_serve_ = sweep_distance(step.o0, built_o0_, built_o1_) <= r && sweep_distance(step.o1, built_o0_, built_o1_) <= r;
+}
+
+void BarrierPotential::make_candidates(StepPositions& step) {
+  lin_bounds_valid_ = false;
+  served_known_ = false;
+  ContactCounters scratch;
+  cands_ = search_.find(step.p0, p1_, step.o0, step.o1, step.obstacle_boxes_current, settings_.thickness + 2.0 * serve_radius(),
+                        scratch);
+  step.obstacle_boxes_current = true;
+  ++builds_;
+  near_reach_of_.assign(cands_.size(), -1.0);
+  guess_ = p1_;
+  built_p0_ = step.p0;
+  built_o0_ = step.o0;
+  built_o1_ = step.o1;
+  obstacles_serve_ = true;
+  prepare_candidates(step);
+}
+
+// Per step (and after a new broad phase): each candidate's distance bound and, where it may be
+// within the thickness, geometry at the start of the step.
+void BarrierPotential::prepare_candidates(const StepPositions& step) {
+  // The last step's final linearisation holds bounds at its end points, the obstacles at its end:
+  // this step's start (the same surface up to the fail-safe's changes and round-off, which the
+  // points' moves from it account for).
+  const bool carried = lin_bounds_valid_ && lin_bounds_.lower.size() == cands_.size() && lin_time_ == t_;
+  double motion = 0.0;
+  if (carried) {
+    point_move_ = (step.p0 - lin_points_).rowwise().norm();
+    motion = 2.0 * point_move_.maxCoeff();
+  }
+  lin_bounds_valid_ = false;
+  // Each pair's geometry at the start of the step: its side (the barrier's distance is signed by
+  // it, see linearise) and, for pairs pressed at the start, lagged friction. (Computed here for
+  // the pairs whose boxes are within the thickness at the start, the others when a linearisation
+  // finds them within it at the end: start_geometry.)
+  cand_start_.resize(cands_.size());
+  cand_start_known_.assign(cands_.size(), 0);
+  cand_start_close_.assign(cands_.size(), 0);
+  std::vector<double>& lower = start_bounds_.lower;
+  if (carried) {
+    lower = lin_bounds_.less(motion);
+  } else {
+    lower.assign(cands_.size(), 0.0);
+  }
+  auto visit = [&](size_t i) {
+    const Candidate& c = cands_[i];
+    if (carried) {
+      const double bound = lin_bounds_.lower[i] - pairs_.motion(c, point_move_, 0.0);
+      lower[i] = std::max(0.0, bound);
+      if (bound >= settings_.thickness) return;
+    }
+    const Corners corner = pairs_.corners(c, step.p0, step.o0);
+    const double gap = box_gap(corner, is_point_triangle(c.kind));
+    lower[i] = std::max(lower[i], gap);
+    if (c.near || !(gap < settings_.thickness)) return;
+    lower[i] = start_geometry(step, i).distance;
+    cand_start_close_[i] = cand_start_[i].distance < settings_.thickness && !pairs_.redundant_on_flat_face(c, cand_start_[i], corner);
+  };
+  if (carried) {
+    for_candidates(&lin_bounds_, motion, settings_.thickness, visit);
+  } else {
+    for_candidates(nullptr, 0.0, 0.0, visit);
+  }
+  start_bounds_.make_close(close_reach());
+}
+
+// Candidate i's geometry at the start of the step (computed once per step; each i by one thread).
+const PairGeometry& BarrierPotential::start_geometry(const StepPositions& step, size_t i) {
+  if (!cand_start_known_[i]) {
+    cand_start_[i] = pairs_.geometry(cands_[i], pairs_.corners(cands_[i], step.p0, step.o0));
+    cand_start_known_[i] = 1;
+  }
+  return cand_start_[i];
+}
+
+// Of the flagged cloth-point–obstacle-triangle candidates, keeps (flagged) the closest triangle
+// per point and obstacle.
+void BarrierPotential::keep_closest(const StepPositions& step, std::vector<char>& flagged,
+                                    const std::vector<PairGeometry>& geometry_of) {
+  const size_t num_obstacles = obstacles_.size();
+  closest_.resize(static_cast<size_t>(step.p0.rows()) * num_obstacles, 0);
+  for (size_t i = 0; i < cands_.size(); ++i) {
+    const Candidate& c = cands_[i];
+    if (!flagged[i] || c.kind != Kind::cloth_point_obstacle_triangle) continue;
+    const int obstacle = obs_.obstacle_of_vertex[static_cast<size_t>(obs_.triangles[static_cast<size_t>(c.b)][0])];
+    const size_t key = static_cast<size_t>(c.a) * num_obstacles + static_cast<size_t>(obstacle);
+    if (closest_[key] == 0) {
+      closest_[key] = i + 1;
+      closest_set_.push_back(key);
+      continue;
+    }
+    const size_t best = closest_[key] - 1;
+    if (geometry_of[i].distance < geometry_of[best].distance) {
+      flagged[best] = 0;
+      closest_[key] = i + 1;
+    } else {
+      flagged[i] = 0;
+    }
+  }
+  for (size_t key : closest_set_) closest_[key] = 0;
+  closest_set_.clear();
+}
+
+// --- Distance bounds ---------------------------------------------------------------------------
+// Lower bounds of the candidates' distances at a reference configuration, so that a pair whose
+// points have moved less than its bound allows is known to be apart without looking at it: the
+// step's start (p0 and the obstacles at t: start_bounds_), or the end points of the last
+// linearisation (obstacles at t + h: lin_bounds_). Most candidates of a resting or slowly moving
+// cloth are decided this way in each linearisation and each step bound; while every pair moves
+// less than a quarter of the thickness from the reference, only the candidates whose bound is
+// within 1.25 thicknesses (close_reach: Bounds::close) are visited at all.
+
+// The barrier's reach for a near pair (parts near each other at rest, which CCD alone keeps from
+// crossing): half the pair's distance at rest, at most the thickness, so that it exerts nothing
+// at rest or anywhere the pair keeps half its rest distance, and resists a fold that presses
+// neighbouring parts into each other (without it such a pair stops Newton only by cutting its
+// steps: the crushed sleeve took 12 solves per step, each cut by an edge pair at 0.2 µm that had
+// been 2 mm apart at rest). Computed once per candidate list, when first needed (each index by
+// one thread).
+double BarrierPotential::near_reach(size_t i) {
+  double& r = near_reach_of_[i];
+  if (r < 0.0) {
+    const Candidate& c = cands_[i];
+    r = std::min(settings_.thickness, 0.5 * pairs_.geometry(c, pairs_.corners(c, surf_.rest_points(), surf_.rest_points())).distance);
+  }
+  return r;
+}
+
+// Calls visit(i), in parallel, for every candidate, or only for the close ones of `bounds` when no
+// pair can move from its bound to below `threshold` with moves of at most `motion` [m].
+template <class Visit>
+void BarrierPotential::for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit) {
+  const bool close_only = bounds != nullptr && bounds->reach - motion >= threshold;
+  const size_t n = close_only ? bounds->close.size() : cands_.size();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t j = range.begin(); j != range.end(); ++j) visit(close_only ? bounds->close[j] : j);
+  });
+}
+
+// Fills point_move_ with each point's largest distance from the reference; the obstacles' move is
+// 0 where the reference is the last linearisation and the obstacles stand at the end of the step.
+ReferenceBounds BarrierPotential::reference_bounds(const StepPositions& step, const Eigen::MatrixX3d& points,
+                                                   const Eigen::MatrixX3d* other, bool whole_step) {
+  const bool lin = lin_bounds_valid_;
+  const Eigen::MatrixX3d& ref = lin ? lin_points_ : step.p0;
+  point_move_ = (points - ref).rowwise().norm();
+  if (other != nullptr) point_move_ = point_move_.cwiseMax((*other - ref).rowwise().norm());
+  const double obstacle = (lin && !whole_step) || step.o0.rows() == 0 ? 0.0 : (step.o1 - step.o0).rowwise().norm().maxCoeff();
+  const double largest = point_move_.size() > 0 ? point_move_.maxCoeff() : 0.0;
+  const double motion = std::max(2.0 * largest, largest + obstacle);
+  return ReferenceBounds{lin ? lin_bounds_ : start_bounds_, point_move_, obstacle, motion};
+}
+
+// --- The step ----------------------------------------------------------------------------------
+bool BarrierPotential::in_step(const Eigen::VectorXd& x, double t, double h) const {
+  return step_start_ == std::pair{t, h} && x.size() == x_.size() && x == x_;
+}
+
+const Eigen::MatrixX3d* BarrierPotential::end_points(const Eigen::VectorXd& v) const {
+  return v.size() == p1_velocity_.size() && v == p1_velocity_ ? &p1_ : nullptr;
+}
+
+double BarrierPotential::velocity_tolerance(double h) const {
+  // 1 % of collision.tolerance's velocity (a fraction of the thickness per step), as the
+  // constraints' response stops its Newton steps: the energy error of the step then stays far
+  // below the tolerance's own scale (docs/contact.md).
+  return 0.01 * settings_.tolerance * settings_.thickness / h;
+}
+
+void BarrierPotential::begin_step(StepPositions& step, const Eigen::VectorXd& x, const Eigen::VectorXd& v_guess, double t,
+                                  double h, const Eigen::VectorXd& diagonal) {
+  t_ = t;
+  h_ = h;
+  x_ = x;
+  step_start_ = {t, h};
+  p1_ = end_points_of(step, v_guess);
+  p1_velocity_ = v_guess;
+  // (The surface points' effective masses are made when a pair needs them: mass_of_point.)
+  const int num_nodes = static_cast<int>(surf_.jacobian().cols() / 3);
+  node_scale_.resize(num_nodes);
+  for (int k = 0; k < num_nodes; ++k) node_scale_(k) = diagonal.segment<3>(3 * k).sum() / 3.0;
+  point_mass_.setConstant(step.p0.rows(), std::numeric_limits<double>::quiet_NaN());
+  check_obstacles_serve(step);
+  served_known_ = false;  // (a new start)
+  if (serves(step.p0, &p1_)) {
+    prepare_candidates(step);
+  } else {
+    make_candidates(step);
+  }
+  // Lagged friction: the pairs pressed at the start of the step, with their normal force and
+  // tangent plane there (fixed over the step, so the friction potential is convex in v).
+  friction_rows_.clear();
+  keep_closest(step, cand_start_close_, cand_start_);
+  for (size_t i = 0; i < cands_.size(); ++i) {
+    if (!cand_start_close_[i]) continue;
+    const CubicBarrier barrier{settings_.thickness, pair_stiffness(cands_[i])};
+    const PairGeometry& g = cand_start_[i];
+    add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(step, g), -barrier.first(g.distance),
+                     [&] { return pair_row(g); });
+  }
+  for (int k : obs_.planes) {
+    const Obstacle& o = obstacles_[static_cast<size_t>(k)];
+    Eigen::Vector3d q0, n0;
+    plane_at(o, t, q0, n0);
+    const RigidMap move = obstacle_step_map(o, t, h_);
+    for (Eigen::Index p = 0; p < step.p0.rows(); ++p) {
+      const Eigen::Vector3d a = step.p0.row(p).transpose();
+      const double dist = n0.dot(a - q0);
+      if (!(dist < settings_.thickness)) continue;
+      const CubicBarrier barrier{settings_.thickness, plane_stiffness(static_cast<int>(p))};
+      add_friction_row(n0, o.friction, -(move(a) - a) / h_, -barrier.first(dist), [&] { return point_row(static_cast<int>(p)); });
+    }
+  }
+}
+
+// A lagged friction row for a pair with normal n, friction coefficient mu, the obstacle side's
+// velocity and normal force lambda [N]; `row` makes the pair's row (only when it is needed).
+template <class MakeRow>
+void BarrierPotential::add_friction_row(const Eigen::Vector3d& normal, double mu, const Eigen::Vector3d& obstacle_velocity,
+                                        double lambda, MakeRow row) {
+  if (!(mu > 0) || !(lambda > 0)) return;
+  FrictionRow f;
+  f.row = row();
+  f.constant = obstacle_velocity;
+  f.tangent -= normal * normal.transpose();
+  f.bound = mu * lambda;
+  friction_rows_.push_back(std::move(f));
+}
+
+void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, PotentialLinearisation& out) {
+  const Eigen::Index n3 = v.size();
+  out.blocks.clear();
+  out.energy = out.dissipation = 0.0;
+  out.active = 0;
+  out.energy_gradient.setZero(n3);
+  out.dissipation_gradient.setZero(n3);
+  if (!(v.size() == p1_velocity_.size() && v == p1_velocity_)) {
+    if (v.size() == bound_to_velocity_.size() && v == bound_to_velocity_) {
+      p1_ = bound_to_points_;  // (the last step bound's end of the move: Newton's next iterate)
+    } else {
+      p1_ = end_points_of(step, v);
+    }
+    p1_velocity_ = v;
+  }
+  // Candidates made for other end points serve while no point is more than half the thickness
+  // from the path they were made for (their boxes are grown by twice the thickness).
+  if (!served(v, p1_)) make_candidates(step);
+  const double dhat = settings_.thickness;
+  // A pair whose distance at the reference (the start, or the last linearisation) exceeds the
+  // thickness by more than its points have moved since cannot be within it now (most candidates
+  // of a slow or resting cloth); the bound each candidate gets here serves the next call.
+  const ReferenceBounds reference = reference_bounds(step, p1_, nullptr, false);
+  const Bounds& bounds = reference.bounds;
+  const double obstacle_motion = reference.obstacle_motion, motion = reference.motion;
+  // (The candidates not visited keep their bound less the largest motion.)
+  Bounds next;
+  next.lower = bounds.less(motion);
+  std::vector<char> active(cands_.size(), 0);
+  end_geometry_.resize(cands_.size());
+  std::vector<PairGeometry>& end = end_geometry_;
+  for_candidates(&bounds, motion, dhat, [&](size_t i) {
+    const Candidate& c = cands_[i];
+    const double bound = bounds.lower[i] - pairs_.motion(c, point_move_, obstacle_motion);
+    next.lower[i] = std::max(0.0, bound);
+    if (bound >= dhat) return;
+    const Corners corner = pairs_.corners(c, p1_, step.o1);
+    const double gap = box_gap(corner, is_point_triangle(c.kind));
+    next.lower[i] = std::max(next.lower[i], gap);
+    const double reach = c.near ? near_reach(i) : dhat;
+    if (gap > reach) return;  // (most candidates: no exact distance)
+    end[i] = pairs_.geometry(c, corner);
+    next.lower[i] = std::max(next.lower[i], end[i].distance);
+    if (pairs_.redundant_on_flat_face(c, end[i], corner)) return;
+    if (end[i].distance < reach) sign_by_start(start_geometry(step, i), end[i], is_point_triangle(c.kind));
+    active[i] = end[i].distance < reach;
+  });
+  next.make_close(close_reach());
+  lin_bounds_ = std::move(next);
+  lin_points_ = p1_;
+  lin_velocity_ = v;
+  lin_time_ = t_ + h_;
+  lin_bounds_valid_ = true;
+  out.point_map = surf_.point_map();
+  auto add_pair = [&](const Row& row, const Eigen::Vector3d& normal, double distance, double k, double reach) {
+    const CubicBarrier barrier{reach, k};
+    out.energy += barrier.value(distance);
+    PotentialLinearisation::Block block;
+    row.put_in(block);
+    row.scatter(surf_, barrier.first(distance) * normal, out.energy_gradient);
+    block.hessian = barrier.second(distance) * normal * normal.transpose();
+    out.blocks.push_back(std::move(block));
+    ++out.active;
+  };
+  // A cloth point against an obstacle keeps its closest triangle only: the barrier is of the
+  // point's distance to the obstacle, the smallest over its triangles (one pair where a point over
+  // a face has several triangles within the thickness, and none of them twice).
+  keep_closest(step, active, end);
+  for (size_t i = 0; i < cands_.size(); ++i)
+    if (active[i])
+      add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(cands_[i]), cands_[i].near ? near_reach(i) : dhat);
+  for (int k : obs_.planes) {
+    Eigen::Vector3d q1, n1;
+    plane_at(obstacles_[static_cast<size_t>(k)], t_ + h_, q1, n1);
+    for (Eigen::Index p = 0; p < p1_.rows(); ++p) {
+      const double dist = n1.dot(p1_.row(p).transpose() - q1);
+      if (dist < dhat) add_pair(point_row(static_cast<int>(p)), n1, dist, plane_stiffness(static_cast<int>(p)), dhat);
+    }
+  }
+  const SmoothedFriction friction{friction_epsilon()};
+  for (const FrictionRow& f : friction_rows_) {
+    const Eigen::Vector3d w = f.tangent * (f.row.apply(surf_, v) + f.constant);
+    out.dissipation += f.bound * friction.f0(w.norm());
+    f.row.scatter(surf_, friction.gradient(w, f.bound), out.dissipation_gradient);
+    PotentialLinearisation::Block block;
+    f.row.put_in(block);
+    block.hessian = friction.hessian(w, f.tangent, f.bound);
+    block.dissipative = true;
+    out.blocks.push_back(std::move(block));
+  }
+}
+
+double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& from, const Eigen::VectorXd& to) {
+  const bool at_linearisation = lin_bounds_valid_ && from.size() == lin_velocity_.size() && from == lin_velocity_;
+  // (End points known already are not made again: the last linearisation's, or those of the
+  // velocities the step began with.)
+  auto points_of = [&](const Eigen::VectorXd& w) {
+    if (const Eigen::MatrixX3d* known = end_points(w)) return Eigen::MatrixX3d(*known);
+    return end_points_of(step, w);
+  };
+  const Eigen::MatrixX3d pa = at_linearisation ? lin_points_ : points_of(from), pb = points_of(to);
+  bound_to_velocity_ = to;
+  bound_to_points_ = pb;
+  // Candidates for the move pa → pb: the potential's where they serve it, else a broad phase over
+  // this move.
+  const std::vector<Candidate>* cands = &cands_;
+  std::vector<Candidate> own;
+  if (!(served(from, pa) && served(to, pb))) {
+    ContactCounters scratch;
+    own = search_.find(pa, pb, step.o0, step.o1, step.obstacle_boxes_current, settings_.thickness, scratch);
+    cands = &own;
+  }
+  // The obstacles stand where they are at the end of the step at both ends of the move.
+  auto corner = [&](const Candidate& c, const Eigen::MatrixX3d& p) {
+    const std::array<int, 4> cloth = pairs_.cloth_points(c);
+    Corners x = pairs_.corners(c, p1_, step.o1);  // (obstacle points at t + h)
+    // corners() puts the cloth points first for every kind but obstacle point–cloth triangle.
+    if (c.kind == Kind::obstacle_point_cloth_triangle) {
+      for (int k = 0; k < 3; ++k) x[static_cast<size_t>(k + 1)] = p.row(cloth[static_cast<size_t>(k)]).transpose();
+    } else {
+      for (size_t k = 0; k < 4; ++k)
+        if (cloth[k] >= 0) x[k] = p.row(cloth[k]).transpose();
+    }
+    return x;
+  };
+  const double eta = settings_.min_separation_ratio * settings_.thickness;
+  const double near_eta = settings_.near_separation_ratio * settings_.thickness;
+  // With the potential's candidates, a pair whose distance bound at the reference exceeds the
+  // separation by more than its points move (to either end of the move) is skipped.
+  std::optional<ReferenceBounds> reference;
+  if (cands == &cands_) reference.emplace(reference_bounds(step, pa, &pb, false));
+  const double obstacle_motion = reference ? reference->obstacle_motion : 0.0;
+  const Eigen::VectorXd step_move = (pb - pa).rowwise().norm();  // per point, over the move
+  const std::vector<double>* lower = reference ? &reference->bounds.lower : nullptr;
+  std::vector<double> bound(cands->size(), 1.0);
+  auto visit = [&](size_t i) {
+    const Candidate& c = (*cands)[i];
+    double separation = c.near ? near_eta : eta;
+    if (lower != nullptr && (*lower)[i] - pairs_.motion(c, point_move_, obstacle_motion) > separation) return;
+    const Corners a = corner(c, pa), b = corner(c, pb);
+    const bool pt = is_point_triangle(c.kind);
+    // A quick reject: the boxes of the swept primitives farther apart than the separation.
+    Corners lo, hi;
+    for (size_t k = 0; k < 4; ++k) {
+      lo[k] = a[k].cwiseMin(b[k]);
+      hi[k] = a[k].cwiseMax(b[k]);
+    }
+    const size_t split = pt ? 1 : 2;  // the first primitive's corners, then the second's
+    Eigen::Vector3d la = lo[0], ha = hi[0], lb = lo[split], hb = hi[split];
+    for (size_t k = 1; k < split; ++k) {
+      la = la.cwiseMin(lo[k]);
+      ha = ha.cwiseMax(hi[k]);
+    }
+    for (size_t k = split + 1; k < 4; ++k) {
+      lb = lb.cwiseMin(lo[k]);
+      hb = hb.cwiseMax(hi[k]);
+    }
+    if (!(((la.array() - separation) <= hb.array()).all() && ((lb.array() - separation) <= ha.array()).all())) return;
+    const double start_distance = pairs_.geometry(c, a).distance;
+    if (!(start_distance > 0)) return;  // (touching already: nothing to bound)
+    separation = std::min(separation, 0.5 * start_distance);
+    // (A pair that does not move enough to lose what it has above the separation: most pairs
+    // resting in contact between two Newton iterates.)
+    if (start_distance - pairs_.motion(c, step_move, 0.0) > separation) return;
+    const CcdResult r = pt ? point_triangle_ccd(a, b, separation) : edge_edge_ccd(a, b, separation);
+    if (r.hit) bound[i] = r.toi;
+  };
+  if (reference) {
+    for_candidates(&reference->bounds, reference->motion, std::max(eta, near_eta), visit);
+  } else {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cands->size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) visit(i);
+    });
+  }
+  double alpha = 1.0;
+  for (double b : bound) alpha = std::min(alpha, b);
+  for (int k : obs_.planes) {
+    Eigen::Vector3d q1, n1;
+    plane_at(obstacles_[static_cast<size_t>(k)], t_ + h_, q1, n1);
+    for (Eigen::Index p = 0; p < pa.rows(); ++p) {
+      const double da = n1.dot(pa.row(p).transpose() - q1), db = n1.dot(pb.row(p).transpose() - q1);
+      if (!(da > 0) || db >= std::min(eta, 0.5 * da)) continue;
+      const double separation = std::min(eta, 0.5 * da);
+      alpha = std::min(alpha, (da - separation) / (da - db));
+    }
+  }
+  return std::max(0.0, alpha);
+}
+
+}  // namespace clothsim::contact
