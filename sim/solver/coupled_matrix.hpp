@@ -6,7 +6,7 @@
 // stored entries) plus the blocks.
 //
 // Used by the contact potential inside the implicit step (sim/integrator/implicit_euler.cpp) and
-// by the contact stage's implicit response (sim/contact/contact_stage.cpp).
+// by the contact fail-safe's implicit response (sim/contact/fail_safe.cpp).
 #pragma once
 
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
 // A potential of the step's end positions that the implicit step minimises together with the
-// elastic model (contact inside the step: sim/contact/contact_potential.hpp, docs/contact.md).
+// elastic model (contact inside the step: sim/contact/barrier_potential.hpp, docs/contact.md).
 //
 // Implicit Euler with the velocities v as unknowns is the minimisation of the incremental
 // potential
