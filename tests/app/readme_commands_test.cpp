@@ -148,6 +148,12 @@ const std::map<std::string, Form>& forms() {
        {{"{python} {src}/scripts/layer_count.py {tmp}/two_layers.obj"},
         "{python} {src}/scripts/layer_count.py --help",
         ""}},
+      // Two steps of a contact scene; its row of the table.
+      {"scripts/contact_ratio.py RUN",
+       {{"{clothsim} {src}/scenes/sheet_on_sphere.json --out {tmp}/ratio --end 0.004 --no-render",
+         "{python} {src}/scripts/contact_ratio.py {tmp}/ratio/sheet_on_sphere | grep -q '| `sheet_on_sphere` | 2 |'"},
+        "{python} {src}/scripts/contact_ratio.py --help",
+        ""}},
       // The timing scene's sleeve at a tiny size, two steps; the table and the plot of its rows.
       {"scripts/scaling.py run --bin CLOTHSIM --csv OUT.csv",
        {{"{python} {src}/scripts/scaling.py run --bin {clothsim} --csv {tmp}/scaling.csv --sizes 8x6 --end 0.02 --repeats 1",
