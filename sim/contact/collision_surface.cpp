@@ -152,20 +152,16 @@ PairGeometry one_point(int p) {
 }  // namespace
 
 void CollisionSurface::make_point_rows() {
-  point_rows_.assign(static_cast<size_t>(rest_.rows()), NodeRow{});
+  point_map_ = PointMap{};
   in_node_form_ = true;
   for (Eigen::Index p = 0; p < rest_.rows(); ++p) {
     NodeRow row = node_row(rows(one_point(static_cast<int>(p))));
     if (!row.dofs.empty()) {
       in_node_form_ = false;
-      point_rows_.clear();
+      point_map_ = PointMap{};
       return;
     }
     std::sort(row.nodes.begin(), row.nodes.end());
-    point_rows_[static_cast<size_t>(p)] = std::move(row);
-  }
-  point_map_ = PointMap{};
-  for (const NodeRow& row : point_rows_) {
     for (const auto& [node, w] : row.nodes) {
       point_map_.nodes.push_back(node);
       point_map_.weights.push_back(w);
@@ -195,43 +191,13 @@ PointRow CollisionSurface::point_alone(int p) const {
 }
 
 NodeRow CollisionSurface::point_row(int p) {
-  if (in_node_form_) return point_rows_[static_cast<size_t>(p)];
+  if (in_node_form_) return point_alone(p).node_row(point_map_);
   return node_row(rows(one_point(p)));
 }
 
 NodeRow CollisionSurface::pair_row(const PairGeometry& g) {
-  if (!in_node_form_) return node_row(rows(g));
-  // One cloth point (against an obstacle or a plane): its row, scaled (the same values as the
-  // merge below gives, without it).
-  int cloth = -1, count = 0;
-  for (int k = 0; k < g.num; ++k)
-    if (!g.obstacle[static_cast<size_t>(k)] && g.coef[static_cast<size_t>(k)] != 0.0) {
-      cloth = k;
-      ++count;
-    }
-  if (count == 1) {
-    NodeRow row = point_rows_[static_cast<size_t>(g.point[static_cast<size_t>(cloth)])];
-    const double coef = g.coef[static_cast<size_t>(cloth)];
-    if (coef != 1.0)
-      for (auto& entry : row.nodes) entry.second *= coef;
-    return row;
-  }
-  NodeRow row;
-  for (int k = 0; k < g.num; ++k) {
-    const double coef = g.coef[static_cast<size_t>(k)];
-    if (g.obstacle[static_cast<size_t>(k)] || coef == 0.0) continue;
-    for (const auto& [node, w] : point_rows_[static_cast<size_t>(g.point[static_cast<size_t>(k)])].nodes) {
-      int& s = slot_[static_cast<size_t>(3 * node)];
-      if (s < 0) {
-        s = static_cast<int>(row.nodes.size());
-        row.nodes.emplace_back(node, 0.0);
-      }
-      row.nodes[static_cast<size_t>(s)].second += coef * w;
-    }
-  }
-  for (const auto& entry : row.nodes) slot_[static_cast<size_t>(3 * entry.first)] = -1;
-  std::sort(row.nodes.begin(), row.nodes.end());
-  return row;
+  if (in_node_form_) return pair_points(g).node_row(point_map_);
+  return node_row(rows(g));
 }
 
 bool CollisionSurface::near_pair(const std::array<int, 3>& a, const std::array<int, 3>& b, double near) const {

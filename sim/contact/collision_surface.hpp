@@ -113,8 +113,7 @@ class CollisionSurface {
   // Scratch for merging rows: a slot per DOF (−1 when unused).
   std::vector<int> slot_;
 
-  // The point rows (make_point_rows), and the same packed (CSR) for end_points.
-  std::vector<NodeRow> point_rows_;
+  // J's rows in node form per point, packed (make_point_rows): end_points, and the rows on points.
   bool in_node_form_ = false;
   PointMap point_map_;
 };

@@ -1,6 +1,11 @@
-// Contact as one stage of the time step: a velocity filter applied after the linear solve
-// (Bridson, Fedkiw & Anderson 2002, as the paper's §6 does), so the system matrix keeps its
-// fixed pattern. It takes the step's start positions x and new velocities v (end positions
+// Contact in the time step, in two roles. By default (collision.method "barrier") proximity is a
+// barrier potential minimised inside the implicit step (sim/contact/barrier_potential.hpp, through
+// the StepPotential calls below), and this stage's filter is the fail-safe after the solve. With
+// "constraints" the filter does all of it, as described next.
+//
+// The filter: a velocity filter applied after the linear solve (Bridson, Fedkiw & Anderson 2002,
+// as the paper's §6 does), so the system matrix keeps its fixed pattern. It takes the step's
+// start positions x and new velocities v (end positions
 // x + h v) and changes the free components of v so that the step ends with the cloth's collision
 // surface separated from itself and from the obstacles (docs/contact.md has the algorithm, its
 // parameters and what is guaranteed).

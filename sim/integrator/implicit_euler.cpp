@@ -151,7 +151,7 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
     // crushed sleeve's step with 1,500 active pairs: the assembly cost more than the rest of the step).
     // The pattern: A's and the couplings of the blocks; rebuilt only when a block needs a coupling it
     // lacks (then the solver analyses the new pattern).
-    auto assemble = [&]() -> Eigen::SparseMatrix<double>& {
+    auto newton_matrix = [&]() -> Eigen::SparseMatrix<double>& {
       const std::vector<std::pair<NodeRow, Eigen::Matrix3d>> node_blocks = blocks_.node_blocks();
       std::vector<std::vector<int>> groups;
       groups.reserve(node_blocks.size());
@@ -177,14 +177,14 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
         symmetric_product(a, w, ones, y);
         blocks_.add_product(w, y);
       };
-      r = solver_.solve(newton_product, static_cast<double>(a.nonZeros()) + blocks_.product_entries(), assemble, rhs, free_, v_new);
+      r = solver_.solve(newton_product, static_cast<double>(a.nonZeros()) + blocks_.product_entries(), newton_matrix, rhs, free_, v_new);
     } else if (blocks_.empty() && solver_.solves_operators() && (coupled_.empty() || coupled_.matrix().nonZeros() == a.nonZeros())) {
       // No blocks, and no couplings in the pattern: A itself (the conjugate-gradient solver leaves
       // it as it is), without copying its values (a quarter of a millisecond per step on the
       // 494-vertex sleeve).
       r = solver_.solve(a, rhs, free_, v_new);
     } else {
-      r = solver_.solve(assemble(), rhs, free_, v_new);
+      r = solver_.solve(newton_matrix(), rhs, free_, v_new);
     }
     total.iterations += r.iterations;
     total.residual = r.residual;

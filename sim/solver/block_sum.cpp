@@ -2,22 +2,15 @@
 
 #include <algorithm>
 #include <functional>
+#include <stdexcept>
 
 namespace clothsim {
 
+// (Only rows over the nodes are hashed: rows on points merge through single_, see build().)
 size_t BlockSum::RowHash::operator()(const Block* b) const {
-  size_t seed = 0;
-  auto mix = [&seed](size_t v) { seed ^= v + 0x9e3779b97f4a7c15ULL + (seed << 6) + (seed >> 2); };
-  if (b->is_on_points()) {
-    mix(static_cast<size_t>(b->on_points.count) + 1000003);
-    for (int k = 0; k < b->on_points.count; ++k) {
-      mix(std::hash<int>{}(b->on_points.points[static_cast<size_t>(k)]));
-      mix(std::hash<double>{}(b->on_points.coefs[static_cast<size_t>(k)]));
-    }
-    return seed;
-  }
   const NodeRow& r = b->row;
-  seed = r.nodes.size() * 31 + r.dofs.size();
+  size_t seed = r.nodes.size() * 31 + r.dofs.size();
+  auto mix = [&seed](size_t v) { seed ^= v + 0x9e3779b97f4a7c15ULL + (seed << 6) + (seed >> 2); };
   for (const auto& [node, w] : r.nodes) {
     mix(std::hash<int>{}(node));
     mix(std::hash<double>{}(w));
@@ -27,7 +20,6 @@ size_t BlockSum::RowHash::operator()(const Block* b) const {
 }
 
 bool BlockSum::RowEqual::operator()(const Block* a, const Block* b) const {
-  if (a->is_on_points() || b->is_on_points()) return a->is_on_points() == b->is_on_points() && a->on_points == b->on_points;
   return a->row.nodes == b->row.nodes && a->row.dofs == b->row.dofs;
 }
 
@@ -46,6 +38,7 @@ void BlockSum::build(const PotentialLinearisation& lin, double h) {
   for (const Block& block : lin.blocks) {
     const double weight = block.dissipative ? h : h * h;
     if (block.is_on_points()) {
+      if (map == nullptr) throw std::invalid_argument("BlockSum: a block on points without the points' map");
       if (block.on_points.count == 1) {
         int& at = single_[static_cast<size_t>(block.on_points.points[0])];
         if (at >= 0 && merged_[static_cast<size_t>(at)].first->on_points.coefs[0] == block.on_points.coefs[0]) {

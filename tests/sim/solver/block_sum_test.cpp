@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 namespace clothsim {
@@ -102,6 +103,11 @@ TEST(BlockSum, ProductIsTheWeightedSumOfBtHBAndRowsMergeOnce) {
   Eigen::VectorXd y = Eigen::VectorXd::Ones(3 * kNodes);
   sum.add_product(Eigen::VectorXd::Ones(3 * kNodes), y);
   EXPECT_EQ(y, Eigen::VectorXd::Ones(3 * kNodes));
+
+  // Rows on points need the points' map.
+  PotentialLinearisation no_map = lin;
+  no_map.point_map = nullptr;
+  EXPECT_THROW(sum.build(no_map, h), std::invalid_argument);
 }
 
 }  // namespace
