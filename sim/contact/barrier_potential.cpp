@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <optional>
 
 namespace clothsim::contact {
@@ -180,11 +181,18 @@ void BarrierPotential::prepare_candidates(const StepPositions& step) {
   // The last step's final linearisation holds bounds at its end points, the obstacles at its end:
   // this step's start (the same surface up to the fail-safe's changes and round-off, which the
   // points' moves from it account for).
-  const bool carried = lin_bounds_valid_ && lin_bounds_.lower.size() == cands_.size() && lin_time_ == t_;
-  double motion = 0.0;
+  // (The step's start time and the last one's end, t + h, agree up to round-off; the obstacles'
+  // vertices then may differ by round-off too, which their move from the last linearisation's
+  // accounts for.)
+  const bool carried = lin_bounds_valid_ && lin_bounds_.lower.size() == cands_.size() &&
+                       std::abs(lin_time_ - t_) <= 1e-9 * h_ && lin_o1_.rows() == step.o0.rows();
+  double motion = 0.0, obstacle_shift = 0.0;
   if (carried) {
     point_move_ = (step.p0 - lin_points_).rowwise().norm();
-    motion = 2.0 * point_move_.maxCoeff();
+    if (step.o0.rows() > 0 && !settings_.obstacles_static)
+      obstacle_shift = (step.o0 - lin_o1_).rowwise().norm().maxCoeff();
+    const double largest = point_move_.size() > 0 ? point_move_.maxCoeff() : 0.0;
+    motion = std::max(2.0 * largest, largest + obstacle_shift);
   }
   lin_bounds_valid_ = false;
   // Each pair's geometry at the start of the step: its side (the barrier's distance is signed by
@@ -203,7 +211,7 @@ void BarrierPotential::prepare_candidates(const StepPositions& step) {
   auto visit = [&](size_t i) {
     const Candidate& c = cands_[i];
     if (carried) {
-      const double bound = lin_bounds_.lower[i] - pairs_.motion(c, point_move_, 0.0);
+      const double bound = lin_bounds_.lower[i] - pairs_.motion(c, point_move_, obstacle_shift);
       lower[i] = std::max(0.0, bound);
       if (bound >= settings_.thickness) return;
     }
@@ -219,7 +227,7 @@ void BarrierPotential::prepare_candidates(const StepPositions& step) {
   } else {
     for_candidates(nullptr, 0.0, 0.0, visit);
   }
-  start_bounds_.make_close(close_reach());
+  start_bounds_.make_close(close_reaches());
 }
 
 // Candidate i's geometry at the start of the step (computed once per step; each i by one thread).
@@ -288,11 +296,19 @@ double BarrierPotential::near_reach(size_t i) {
 // pair can move from its bound to below `threshold` with moves of at most `motion` [m].
 template <class Visit>
 void BarrierPotential::for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit) {
-  const bool close_only = bounds != nullptr && bounds->reach - motion >= threshold;
-  const size_t n = close_only ? bounds->close.size() : cands_.size();
+  const std::vector<size_t>* list = bounds != nullptr ? bounds->within(threshold, motion) : nullptr;
+  const size_t n = list != nullptr ? list->size() : cands_.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t j = range.begin(); j != range.end(); ++j) visit(close_only ? bounds->close[j] : j);
+    for (size_t j = range.begin(); j != range.end(); ++j) visit(list != nullptr ? (*list)[j] : j);
   });
+}
+
+// The reaches of the bounds' lists: the barrier's (the thickness) and the step bound's (the
+// largest separation) each with a twentieth of the thickness to spare, and close_reach().
+std::vector<double> BarrierPotential::close_reaches() const {
+  const double dhat = settings_.thickness;
+  const double separation = std::max(settings_.min_separation_ratio, settings_.near_separation_ratio) * dhat;
+  return {separation + 0.05 * dhat, 1.05 * dhat, close_reach()};
 }
 
 // Fills point_move_ with each point's largest distance from the reference; the obstacles' move is
@@ -432,11 +448,16 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
     if (end[i].distance < reach) sign_by_start(start_geometry(step, i), end[i], is_point_triangle(c.kind));
     active[i] = end[i].distance < reach;
   });
-  next.make_close(close_reach());
+  next.make_close(close_reaches());
   lin_bounds_ = std::move(next);
   lin_points_ = p1_;
   lin_velocity_ = v;
   lin_time_ = t_ + h_;
+  if (settings_.obstacles_static) {
+    lin_o1_.resize(step.o1.rows(), 3);  // (only its size is read: o1 is the same every step)
+  } else {
+    lin_o1_ = step.o1;
+  }
   lin_bounds_valid_ = true;
   out.point_map = surf_.point_map();
   auto add_pair = [&](const Row& row, const Eigen::Vector3d& normal, double distance, double k, double reach) {
@@ -485,7 +506,10 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
     if (const Eigen::MatrixX3d* known = end_points(w)) return Eigen::MatrixX3d(*known);
     return end_points_of(step, w);
   };
-  const Eigen::MatrixX3d pa = at_linearisation ? lin_points_ : points_of(from), pb = points_of(to);
+  // (Velocities zero, as where Newton's start is checked from the held start with nothing
+  // prescribed, end where the step starts: p0 + h J 0 = p0.)
+  const bool from_start = !at_linearisation && from.size() == x_.size() && (from.array() == 0.0).all();
+  const Eigen::MatrixX3d pa = at_linearisation ? lin_points_ : from_start ? step.p0 : points_of(from), pb = points_of(to);
   bound_to_velocity_ = to;
   bound_to_points_ = pb;
   // Candidates for the move pa → pb: the potential's where they serve it, else a broad phase over
@@ -519,7 +543,9 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
   const double obstacle_motion = reference ? reference->obstacle_motion : 0.0;
   const Eigen::VectorXd step_move = (pb - pa).rowwise().norm();  // per point, over the move
   const std::vector<double>* lower = reference ? &reference->bounds.lower : nullptr;
-  std::vector<double> bound(cands->size(), 1.0);
+  // (Hits are rare: the smallest fraction is kept under a lock rather than per candidate.)
+  double alpha = 1.0;
+  std::mutex alpha_mutex;
   auto visit = [&](size_t i) {
     const Candidate& c = (*cands)[i];
     double separation = c.near ? near_eta : eta;
@@ -550,7 +576,10 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
     // resting in contact between two Newton iterates.)
     if (start_distance - pairs_.motion(c, step_move, 0.0) > separation) return;
     const CcdResult r = pt ? point_triangle_ccd(a, b, separation) : edge_edge_ccd(a, b, separation);
-    if (r.hit) bound[i] = r.toi;
+    if (r.hit) {
+      const std::lock_guard<std::mutex> lock(alpha_mutex);
+      alpha = std::min(alpha, r.toi);
+    }
   };
   if (reference) {
     for_candidates(&reference->bounds, reference->motion, std::max(eta, near_eta), visit);
@@ -559,8 +588,6 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
       for (size_t i = range.begin(); i != range.end(); ++i) visit(i);
     });
   }
-  double alpha = 1.0;
-  for (double b : bound) alpha = std::min(alpha, b);
   for (int k : obs_.planes) {
     Eigen::Vector3d q1, n1;
     plane_at(obstacles_[static_cast<size_t>(k)], t_ + h_, q1, n1);

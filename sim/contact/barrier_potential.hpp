@@ -141,6 +141,7 @@ class BarrierPotential {
   const PairGeometry& start_geometry(const StepPositions& step, size_t i);
   void keep_closest(const StepPositions& step, std::vector<char>& flagged, const std::vector<PairGeometry>& geometry_of);
   double close_reach() const { return 1.25 * settings_.thickness; }
+  std::vector<double> close_reaches() const;
   double near_reach(size_t i);
   template <class Visit>
   void for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit);
@@ -188,6 +189,7 @@ class BarrierPotential {
   Eigen::VectorXd lin_velocity_;     // ... and the velocities they were made from
   bool lin_bounds_valid_ = false;    // lin_bounds_ hold for the current candidates
   double lin_time_ = -1.0;           // the time of lin_points_ (the end of its step) [s]
+  Eigen::MatrixX3d lin_o1_;          // the obstacle vertices there (sized only, when they are static)
   Eigen::VectorXd bound_to_velocity_;  // the last step bound's velocities at the end of its move
   Eigen::MatrixX3d bound_to_points_;   // ... and their end points
   Eigen::VectorXd point_move_;       // per surface point, its move from the reference [m]

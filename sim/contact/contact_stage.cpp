@@ -14,11 +14,12 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <atomic>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 
@@ -238,15 +239,18 @@ struct ContactStage::Impl {
     std::vector<Found> out;
     if (hit_pairs) hit_pairs->clear();
     // The CCD of every pair in parallel (each pair alone), then the hits in the pairs' order.
-    std::vector<double> toi(cands.size(), -1.0);  // −1: not tested or no hit
+    // (Hits are rare: they are gathered under a lock and put in the pairs' order after.)
+    std::vector<std::pair<size_t, double>> toi;  // (candidate, time of impact)
+    std::mutex toi_mutex;
     std::atomic<long long> tested{0};
     const std::vector<double>* lower = bounds != nullptr ? &bounds->lower : nullptr;
-    const bool close_only = bounds != nullptr && bounds->reach - motion >= std::max(eta, params.near_separation_ratio * settings.thickness);
-    const size_t n = close_only ? bounds->close.size() : cands.size();
+    const std::vector<size_t>* list =
+        bounds != nullptr ? bounds->within(std::max(eta, params.near_separation_ratio * settings.thickness), motion) : nullptr;
+    const size_t n = list != nullptr ? list->size() : cands.size();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
       long long count = 0;
       for (size_t j = range.begin(); j != range.end(); ++j) {
-        const size_t i = close_only ? bounds->close[j] : j;
+        const size_t i = list != nullptr ? (*list)[j] : j;
         const Candidate& c = cands[i];
         const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
         if (lower != nullptr && (*lower)[i] - pairs.motion(c, reference->point_move, obstacle_motion) > separation) continue;
@@ -259,18 +263,21 @@ struct ContactStage::Impl {
         const std::array<Eigen::Vector3d, 4> a = corners(c, false), b = corners(c, true);
         const contact::CcdResult r = is_point_triangle(c.kind) ? contact::point_triangle_ccd(a, b, separation)
                                                                : contact::edge_edge_ccd(a, b, separation);
-        if (r.hit) toi[i] = r.toi;
+        if (r.hit) {
+          const std::lock_guard<std::mutex> lock(toi_mutex);
+          toi.emplace_back(i, r.toi);
+        }
       }
       tested += count;
     });
     report.pairs_tested += tested.load();
-    for (size_t i = 0; i < cands.size(); ++i) {
-      if (toi[i] < 0) continue;
+    std::sort(toi.begin(), toi.end());
+    for (const auto& [i, time] : toi) {
       const Candidate& c = cands[i];
       const std::array<Eigen::Vector3d, 4> a = corners(c, false), b = corners(c, true);
       const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
       std::array<Eigen::Vector3d, 4> x;
-      for (size_t k = 0; k < 4; ++k) x[k] = a[k] + toi[i] * (b[k] - a[k]);
+      for (size_t k = 0; k < 4; ++k) x[k] = a[k] + time * (b[k] - a[k]);
       const PairGeometry g = pairs.geometry(c, x);
       if (pairs.redundant_on_flat_face(c, g, x)) continue;
       out.push_back({constraint(g), g.distance, separation, key_of(c, 1)});

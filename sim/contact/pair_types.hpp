@@ -36,16 +36,33 @@ struct Candidate {
 };
 
 // Lower bounds of the distances of a list of candidate pairs at some configuration
-// (BarrierPotential::reference_bounds, sim/contact/barrier_potential.hpp), and those below a reach.
+// (BarrierPotential::reference_bounds, sim/contact/barrier_potential.hpp), and the candidates whose
+// bound is below each of a few reaches, so that a pass that needs only the pairs that can come
+// within some distance visits the shortest list that holds them (a resting drape's step bound
+// visits none of its tens of thousands of candidates, its linearisation those within the barrier's
+// reach).
 struct Bounds {
+  struct List {
+    double reach = 0.0;         // [m]
+    std::vector<size_t> index;  // the candidates whose bound is below `reach`, in order
+  };
   std::vector<double> lower;    // per candidate [m]
-  std::vector<size_t> close;    // the candidates whose bound is below `reach`
-  double reach = 0.0;           // [m]
-  void make_close(double r) {
-    reach = r;
-    close.clear();
+  std::vector<List> lists;      // by increasing reach
+  // Makes the lists for `reaches` (any order) in one pass over the bounds.
+  void make_close(std::vector<double> reaches) {
+    std::sort(reaches.begin(), reaches.end());
+    lists.assign(reaches.size(), List{});
+    for (size_t k = 0; k < reaches.size(); ++k) lists[k].reach = reaches[k];
     for (size_t i = 0; i < lower.size(); ++i)
-      if (lower[i] < r) close.push_back(i);
+      for (List& l : lists)
+        if (lower[i] < l.reach) l.index.push_back(i);
+  }
+  // The shortest list that holds every candidate whose distance may be below `threshold` after
+  // each pair's distance changed by at most `motion` [m]; nullptr when that may be any candidate.
+  const std::vector<size_t>* within(double threshold, double motion) const {
+    for (const List& l : lists)
+      if (l.reach - motion >= threshold) return &l.index;
+    return nullptr;
   }
   // The bounds less `motion` (at least 0): the bounds after every point moved by at most that.
   std::vector<double> less(double motion) const {
