@@ -211,6 +211,7 @@ void BarrierPotential::prepare_candidates(const StepPositions& step) {
   auto visit = [&](size_t i) {
     const Candidate& c = cands_[i];
     if (carried) {
+      if (lin_bounds_.lower[i] - motion >= settings_.thickness) return;  // (without the pair's own motion)
       const double bound = lin_bounds_.lower[i] - pairs_.motion(c, point_move_, obstacle_shift);
       lower[i] = std::max(0.0, bound);
       if (bound >= settings_.thickness) return;
@@ -296,10 +297,10 @@ double BarrierPotential::near_reach(size_t i) {
 // pair can move from its bound to below `threshold` with moves of at most `motion` [m].
 template <class Visit>
 void BarrierPotential::for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit) {
-  const std::vector<size_t>* list = bounds != nullptr ? bounds->within(threshold, motion) : nullptr;
-  const size_t n = list != nullptr ? list->size() : cands_.size();
+  const Bounds::List list = bounds != nullptr ? bounds->within(threshold, motion) : Bounds::List{};
+  const size_t n = list.index != nullptr ? list.size : cands_.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
-    for (size_t j = range.begin(); j != range.end(); ++j) visit(list != nullptr ? (*list)[j] : j);
+    for (size_t j = range.begin(); j != range.end(); ++j) visit(list.index != nullptr ? list[j] : j);
   });
 }
 
@@ -434,6 +435,7 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
   std::vector<PairGeometry>& end = end_geometry_;
   for_candidates(&bounds, motion, dhat, [&](size_t i) {
     const Candidate& c = cands_[i];
+    if (bounds.lower[i] - motion >= dhat) return;  // (without the pair's own motion, below)
     const double bound = bounds.lower[i] - pairs_.motion(c, point_move_, obstacle_motion);
     next.lower[i] = std::max(0.0, bound);
     if (bound >= dhat) return;
@@ -549,7 +551,9 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
   auto visit = [&](size_t i) {
     const Candidate& c = (*cands)[i];
     double separation = c.near ? near_eta : eta;
-    if (lower != nullptr && (*lower)[i] - pairs_.motion(c, point_move_, obstacle_motion) > separation) return;
+    if (lower != nullptr && ((*lower)[i] - reference->motion > separation ||
+                             (*lower)[i] - pairs_.motion(c, point_move_, obstacle_motion) > separation))
+      return;
     const Corners a = corner(c, pa), b = corner(c, pb);
     const bool pt = is_point_triangle(c.kind);
     // A quick reject: the boxes of the swept primitives farther apart than the separation.

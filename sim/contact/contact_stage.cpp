@@ -244,16 +244,18 @@ struct ContactStage::Impl {
     std::mutex toi_mutex;
     std::atomic<long long> tested{0};
     const std::vector<double>* lower = bounds != nullptr ? &bounds->lower : nullptr;
-    const std::vector<size_t>* list =
-        bounds != nullptr ? bounds->within(std::max(eta, params.near_separation_ratio * settings.thickness), motion) : nullptr;
-    const size_t n = list != nullptr ? list->size() : cands.size();
+    const Bounds::List list =
+        bounds != nullptr ? bounds->within(std::max(eta, params.near_separation_ratio * settings.thickness), motion) : Bounds::List{};
+    const size_t n = list.index != nullptr ? list.size : cands.size();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
       long long count = 0;
       for (size_t j = range.begin(); j != range.end(); ++j) {
-        const size_t i = list != nullptr ? (*list)[j] : j;
+        const size_t i = list.index != nullptr ? list[j] : j;
         const Candidate& c = cands[i];
         const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
-        if (lower != nullptr && (*lower)[i] - pairs.motion(c, reference->point_move, obstacle_motion) > separation) continue;
+        if (lower != nullptr && ((*lower)[i] - motion > separation ||
+                                 (*lower)[i] - pairs.motion(c, reference->point_move, obstacle_motion) > separation))
+          continue;
         if (moved != nullptr) {
           bool any = false;
           for (int p : pairs.cloth_points(c)) any = any || (p >= 0 && (*moved)[static_cast<size_t>(p)]);

@@ -42,27 +42,50 @@ struct Candidate {
 // visits none of its tens of thousands of candidates, its linearisation those within the barrier's
 // reach).
 struct Bounds {
+  // A list of candidates: index[0 .. size).
   struct List {
-    double reach = 0.0;         // [m]
-    std::vector<size_t> index;  // the candidates whose bound is below `reach`, in order
+    const size_t* index = nullptr;
+    size_t size = 0;
+    size_t operator[](size_t j) const { return index[j]; }
   };
   std::vector<double> lower;    // per candidate [m]
-  std::vector<List> lists;      // by increasing reach
-  // Makes the lists for `reaches` (any order) in one pass over the bounds.
-  void make_close(std::vector<double> reaches) {
-    std::sort(reaches.begin(), reaches.end());
-    lists.assign(reaches.size(), List{});
-    for (size_t k = 0; k < reaches.size(); ++k) lists[k].reach = reaches[k];
+  std::vector<double> reaches;  // increasing [m]
+  // The candidates with a bound below the largest reach, those below the smallest first, then
+  // those below the next, and so on (each part in increasing order); ends[k] counts those below
+  // reaches[k].
+  std::vector<size_t> close;
+  std::vector<size_t> ends;
+  // Makes the lists for `reaches` (any order), in two passes over the bounds.
+  void make_close(std::vector<double> r) {
+    std::sort(r.begin(), r.end());
+    reaches = std::move(r);
+    const size_t levels = reaches.size();
+    level_.resize(lower.size());
+    std::vector<size_t> count(levels + 1, 0);
+    for (size_t i = 0; i < lower.size(); ++i) {
+      unsigned char k = 0;
+      for (double reach : reaches) k = static_cast<unsigned char>(k + (lower[i] >= reach));
+      level_[i] = k;
+      ++count[k];
+    }
+    ends.assign(levels, 0);
+    std::vector<size_t> next(levels + 1, 0);
+    for (size_t k = 0, sum = 0; k < levels; ++k) {
+      next[k] = sum;
+      sum += count[k];
+      ends[k] = sum;
+    }
+    close.resize(levels > 0 ? ends.back() : 0);
     for (size_t i = 0; i < lower.size(); ++i)
-      for (List& l : lists)
-        if (lower[i] < l.reach) l.index.push_back(i);
+      if (level_[i] < levels) close[next[level_[i]]++] = i;
   }
   // The shortest list that holds every candidate whose distance may be below `threshold` after
-  // each pair's distance changed by at most `motion` [m]; nullptr when that may be any candidate.
-  const std::vector<size_t>* within(double threshold, double motion) const {
-    for (const List& l : lists)
-      if (l.reach - motion >= threshold) return &l.index;
-    return nullptr;
+  // each pair's distance changed by at most `motion` [m]; none (index nullptr) when that may be
+  // any candidate.
+  List within(double threshold, double motion) const {
+    for (size_t k = 0; k < reaches.size(); ++k)
+      if (reaches[k] - motion >= threshold) return List{close.data(), ends[k]};
+    return List{};
   }
   // The bounds less `motion` (at least 0): the bounds after every point moved by at most that.
   std::vector<double> less(double motion) const {
@@ -70,6 +93,9 @@ struct Bounds {
     for (size_t i = 0; i < lower.size(); ++i) out[i] = std::max(0.0, lower[i] - motion);
     return out;
   }
+
+ private:
+  std::vector<unsigned char> level_;  // (make_close's scratch)
 };
 
 // Geometry of one pair at one instant: up to four points on each side with coefficients

@@ -9,17 +9,27 @@
 namespace clothsim::contact {
 namespace {
 
-TEST(DistanceBounds, CloseListsHoldTheBoundsBelowTheirReachesInOrder) {
+// The candidates of a list, sorted (a list's order is by level).
+std::vector<size_t> sorted(const Bounds::List& list) {
+  std::vector<size_t> out(list.index, list.index + list.size);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(DistanceBounds, CloseListsHoldTheBoundsBelowTheirReaches) {
   Bounds b;
   b.lower = {0.5, 3.0, 0.0, 1.2, 2.0};
   b.make_close({1.25, 0.1, 2.5});
-  ASSERT_EQ(b.lists.size(), 3u);
-  EXPECT_EQ(b.lists[0].reach, 0.1);  // (by increasing reach)
-  EXPECT_EQ(b.lists[0].index, (std::vector<size_t>{2}));
-  EXPECT_EQ(b.lists[1].index, (std::vector<size_t>{0, 2, 3}));
-  EXPECT_EQ(b.lists[2].index, (std::vector<size_t>{0, 2, 3, 4}));
+  ASSERT_EQ(b.reaches, (std::vector<double>{0.1, 1.25, 2.5}));  // (by increasing reach)
+  ASSERT_EQ(b.ends, (std::vector<size_t>{1, 3, 4}));
+  EXPECT_EQ(sorted(b.within(0.1, 0.0)), (std::vector<size_t>{2}));
+  EXPECT_EQ(sorted(b.within(1.25, 0.0)), (std::vector<size_t>{0, 2, 3}));
+  EXPECT_EQ(sorted(b.within(2.5, 0.0)), (std::vector<size_t>{0, 2, 3, 4}));
+  // Each level in increasing order: below 0.1, then [0.1, 1.25), then [1.25, 2.5).
+  EXPECT_EQ(b.close, (std::vector<size_t>{2, 0, 3, 4}));
   b.make_close({0.0});  // nothing is below zero
-  EXPECT_TRUE(b.lists[0].index.empty());
+  EXPECT_EQ(b.within(0.0, 0.0).size, 0u);
+  EXPECT_NE(b.within(0.0, 0.0).index, nullptr);
 }
 
 TEST(DistanceBounds, WithinPicksTheShortestListThatHoldsEveryPairThatCanComeBelowTheThreshold) {
@@ -27,20 +37,19 @@ TEST(DistanceBounds, WithinPicksTheShortestListThatHoldsEveryPairThatCanComeBelo
   b.lower = {0.5, 3.0, 0.0, 1.2, 2.0};
   b.make_close({0.15, 1.05, 1.25});
   // Pairs below 0.1 after moves of 0.01: bounds below 0.11, so the 0.15 list.
-  ASSERT_NE(b.within(0.1, 0.01), nullptr);
-  EXPECT_EQ(*b.within(0.1, 0.01), (std::vector<size_t>{2}));
+  EXPECT_EQ(b.within(0.1, 0.01).size, 1u);
   // Below 1.0 after moves of 0.1: bounds below 1.1, so the 1.25 list (1.05 − 0.1 < 1.0).
-  EXPECT_EQ(*b.within(1.0, 0.1), (std::vector<size_t>{0, 2, 3}));
-  EXPECT_EQ(b.within(1.0, 0.1), &b.lists[2].index);
+  EXPECT_EQ(b.within(1.0, 0.1).size, 3u);
+  EXPECT_EQ(sorted(b.within(1.0, 0.1)), (std::vector<size_t>{0, 2, 3}));
   // Moves larger than every list allows: all candidates.
-  EXPECT_EQ(b.within(1.0, 0.5), nullptr);
+  EXPECT_EQ(b.within(1.0, 0.5).index, nullptr);
   // Every candidate that a list leaves out stays above the threshold.
   for (double threshold : {0.05, 0.1, 0.9, 1.0}) {
     for (double motion : {0.0, 0.01, 0.04, 0.2}) {
-      const std::vector<size_t>* list = b.within(threshold, motion);
-      if (list == nullptr) continue;
+      const std::vector<size_t> list = sorted(b.within(threshold, motion));
+      if (b.within(threshold, motion).index == nullptr) continue;
       for (size_t i = 0; i < b.lower.size(); ++i) {
-        if (std::find(list->begin(), list->end(), i) == list->end()) {
+        if (!std::binary_search(list.begin(), list.end(), i)) {
           EXPECT_GE(b.lower[i] - motion, threshold);
         }
       }
