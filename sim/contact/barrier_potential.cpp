@@ -162,9 +162,32 @@ void BarrierPotential::make_candidates(StepPositions& step) {
   lin_bounds_valid_ = false;
   served_known_ = false;
   ContactCounters scratch;
-  cands_ = search_.find(step.p0, p1_, step.o0, step.o1, step.obstacle_boxes_current, settings_.thickness + 2.0 * serve_radius(),
-                        scratch);
+  const double grow = settings_.thickness + 2.0 * serve_radius();
+  cands_ = search_.find(step.p0, p1_, step.o0, step.o1, step.obstacle_boxes_current, grow, scratch);
   step.obstacle_boxes_current = true;
+  // Boxes overlap where the primitives are far apart (a point over a flat face with a fan of long
+  // triangles: cusick_drape's 72-wedge support top gave 72k pairs for 20k points). A pair whose
+  // distance at the start, less how far its points move along the paths the candidates are made
+  // for, is at least `grow` cannot come within the thickness anywhere they serve (each point within
+  // serve_radius of its path), so it is dropped: every later pass over the candidates is shorter.
+  {
+    const Eigen::VectorXd path = (p1_ - step.p0).rowwise().norm();
+    const double obstacle_path = step.o0.rows() > 0 ? (step.o1 - step.o0).rowwise().norm().maxCoeff() : 0.0;
+    std::vector<char> keep(cands_.size(), 1);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cands_.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t i = range.begin(); i != range.end(); ++i) {
+        const Candidate& c = cands_[i];
+        const Corners corner = pairs_.corners(c, step.p0, step.o0);
+        const double motion = pairs_.motion(c, path, obstacle_path);
+        // (A box gap is a lower bound of the distance, and cheaper.)
+        keep[i] = box_gap(corner, is_point_triangle(c.kind)) - motion < grow && pairs_.geometry(c, corner).distance - motion < grow;
+      }
+    });
+    size_t n = 0;
+    for (size_t i = 0; i < cands_.size(); ++i)
+      if (keep[i]) cands_[n++] = cands_[i];
+    cands_.resize(n);
+  }
   ++builds_;
   near_reach_of_.assign(cands_.size(), -1.0);
   guess_ = p1_;
@@ -194,6 +217,10 @@ void BarrierPotential::prepare_candidates(const StepPositions& step) {
     const double largest = point_move_.size() > 0 ? point_move_.maxCoeff() : 0.0;
     motion = std::max(2.0 * largest, largest + obstacle_shift);
   }
+  // Where the last linearisation was at this start up to round-off (the step's velocities are its
+  // last iterate's, and the fail-safe changed nothing), its pairs' geometry is the start's: most
+  // pairs of a resting cloth (the start's geometry then differs from its own by round-off only).
+  const bool reuse = carried && motion <= 1e-9 * settings_.thickness && end_known_.size() == cands_.size();
   lin_bounds_valid_ = false;
   // Each pair's geometry at the start of the step: its side (the barrier's distance is signed by
   // it, see linearise) and, for pairs pressed at the start, lagged friction. (Computed here for
@@ -220,14 +247,19 @@ void BarrierPotential::prepare_candidates(const StepPositions& step) {
     const double gap = box_gap(corner, is_point_triangle(c.kind));
     lower[i] = std::max(lower[i], gap);
     if (c.near || !(gap < settings_.thickness)) return;
-    lower[i] = start_geometry(step, i).distance;
+    if (reuse && end_known_[i]) {
+      // (The last linearisation's geometry, of this start up to round-off: its bound less that.)
+      cand_start_[i] = end_geometry_[i];
+      cand_start_known_[i] = 1;
+      lower[i] = std::max(0.0, cand_start_[i].distance - motion);
+    } else {
+      lower[i] = start_geometry(step, i).distance;
+    }
     cand_start_close_[i] = cand_start_[i].distance < settings_.thickness && !pairs_.redundant_on_flat_face(c, cand_start_[i], corner);
   };
-  if (carried) {
-    for_candidates(&lin_bounds_, motion, settings_.thickness, visit);
-  } else {
-    for_candidates(nullptr, 0.0, 0.0, visit);
-  }
+  const Bounds::List visited =
+      carried ? for_candidates(&lin_bounds_, motion, settings_.thickness, visit) : for_candidates(nullptr, 0.0, 0.0, visit);
+  start_close_ = flagged_among(visited, cand_start_close_);
   start_bounds_.make_close(close_reaches());
 }
 
@@ -243,10 +275,10 @@ const PairGeometry& BarrierPotential::start_geometry(const StepPositions& step, 
 // Of the flagged cloth-point–obstacle-triangle candidates, keeps (flagged) the closest triangle
 // per point and obstacle.
 void BarrierPotential::keep_closest(const StepPositions& step, std::vector<char>& flagged,
-                                    const std::vector<PairGeometry>& geometry_of) {
+                                    const std::vector<PairGeometry>& geometry_of, std::vector<size_t>& which) {
   const size_t num_obstacles = obstacles_.size();
   closest_.resize(static_cast<size_t>(step.p0.rows()) * num_obstacles, 0);
-  for (size_t i = 0; i < cands_.size(); ++i) {
+  for (size_t i : which) {
     const Candidate& c = cands_[i];
     if (!flagged[i] || c.kind != Kind::cloth_point_obstacle_triangle) continue;
     const int obstacle = obs_.obstacle_of_vertex[static_cast<size_t>(obs_.triangles[static_cast<size_t>(c.b)][0])];
@@ -266,6 +298,7 @@ void BarrierPotential::keep_closest(const StepPositions& step, std::vector<char>
   }
   for (size_t key : closest_set_) closest_[key] = 0;
   closest_set_.clear();
+  which.erase(std::remove_if(which.begin(), which.end(), [&](size_t i) { return !flagged[i]; }), which.end());
 }
 
 // --- Distance bounds ---------------------------------------------------------------------------
@@ -296,12 +329,27 @@ double BarrierPotential::near_reach(size_t i) {
 // Calls visit(i), in parallel, for every candidate, or only for the close ones of `bounds` when no
 // pair can move from its bound to below `threshold` with moves of at most `motion` [m].
 template <class Visit>
-void BarrierPotential::for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit) {
+Bounds::List BarrierPotential::for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit) {
   const Bounds::List list = bounds != nullptr ? bounds->within(threshold, motion) : Bounds::List{};
   const size_t n = list.index != nullptr ? list.size : cands_.size();
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t j = range.begin(); j != range.end(); ++j) visit(list.index != nullptr ? list[j] : j);
   });
+  return list;
+}
+
+// The candidates of `visited` (all where its index is null) that are flagged, in increasing order.
+std::vector<size_t> BarrierPotential::flagged_among(const Bounds::List& visited, const std::vector<char>& flagged) const {
+  std::vector<size_t> out;
+  if (visited.index == nullptr) {
+    for (size_t i = 0; i < flagged.size(); ++i)
+      if (flagged[i]) out.push_back(i);
+    return out;
+  }
+  for (size_t j = 0; j < visited.size; ++j)
+    if (flagged[visited[j]]) out.push_back(visited[j]);
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 // The reaches of the bounds' lists: the barrier's (the thickness) and the step bound's (the
@@ -365,9 +413,8 @@ void BarrierPotential::begin_step(StepPositions& step, const Eigen::VectorXd& x,
   // Lagged friction: the pairs pressed at the start of the step, with their normal force and
   // tangent plane there (fixed over the step, so the friction potential is convex in v).
   friction_rows_.clear();
-  keep_closest(step, cand_start_close_, cand_start_);
-  for (size_t i = 0; i < cands_.size(); ++i) {
-    if (!cand_start_close_[i]) continue;
+  keep_closest(step, cand_start_close_, cand_start_, start_close_);
+  for (size_t i : start_close_) {
     const CubicBarrier barrier{settings_.thickness, pair_stiffness(cands_[i])};
     const PairGeometry& g = cand_start_[i];
     add_friction_row(g.normal, pair_friction(g), obstacle_side_velocity(step, g), -barrier.first(g.distance),
@@ -432,8 +479,9 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
   next.lower = bounds.less(motion);
   std::vector<char> active(cands_.size(), 0);
   end_geometry_.resize(cands_.size());
+  end_known_.assign(cands_.size(), 0);
   std::vector<PairGeometry>& end = end_geometry_;
-  for_candidates(&bounds, motion, dhat, [&](size_t i) {
+  const Bounds::List visited = for_candidates(&bounds, motion, dhat, [&](size_t i) {
     const Candidate& c = cands_[i];
     if (bounds.lower[i] - motion >= dhat) return;  // (without the pair's own motion, below)
     const double bound = bounds.lower[i] - pairs_.motion(c, point_move_, obstacle_motion);
@@ -445,11 +493,14 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
     const double reach = c.near ? near_reach(i) : dhat;
     if (gap > reach) return;  // (most candidates: no exact distance)
     end[i] = pairs_.geometry(c, corner);
+    end_known_[i] = 1;
     next.lower[i] = std::max(next.lower[i], end[i].distance);
     if (pairs_.redundant_on_flat_face(c, end[i], corner)) return;
     if (end[i].distance < reach) sign_by_start(start_geometry(step, i), end[i], is_point_triangle(c.kind));
     active[i] = end[i].distance < reach;
   });
+  // (Before the bounds the visited list refers to are replaced.)
+  std::vector<size_t> active_list = flagged_among(visited, active);
   next.make_close(close_reaches());
   lin_bounds_ = std::move(next);
   lin_points_ = p1_;
@@ -475,10 +526,9 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
   // A cloth point against an obstacle keeps its closest triangle only: the barrier is of the
   // point's distance to the obstacle, the smallest over its triangles (one pair where a point over
   // a face has several triangles within the thickness, and none of them twice).
-  keep_closest(step, active, end);
-  for (size_t i = 0; i < cands_.size(); ++i)
-    if (active[i])
-      add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(cands_[i]), cands_[i].near ? near_reach(i) : dhat);
+  keep_closest(step, active, end, active_list);
+  for (size_t i : active_list)
+    add_pair(pair_row(end[i]), end[i].normal, end[i].distance, pair_stiffness(cands_[i]), cands_[i].near ? near_reach(i) : dhat);
   for (int k : obs_.planes) {
     Eigen::Vector3d q1, n1;
     plane_at(obstacles_[static_cast<size_t>(k)], t_ + h_, q1, n1);

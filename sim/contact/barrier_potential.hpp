@@ -139,12 +139,15 @@ class BarrierPotential {
   void make_candidates(StepPositions& step);
   void prepare_candidates(const StepPositions& step);
   const PairGeometry& start_geometry(const StepPositions& step, size_t i);
-  void keep_closest(const StepPositions& step, std::vector<char>& flagged, const std::vector<PairGeometry>& geometry_of);
+  // (`which`: the flagged candidates in increasing order; those unflagged are taken out of it too.)
+  void keep_closest(const StepPositions& step, std::vector<char>& flagged, const std::vector<PairGeometry>& geometry_of,
+                    std::vector<size_t>& which);
+  std::vector<size_t> flagged_among(const Bounds::List& visited, const std::vector<char>& flagged) const;
   double close_reach() const { return 1.25 * settings_.thickness; }
   std::vector<double> close_reaches() const;
   double near_reach(size_t i);
   template <class Visit>
-  void for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit);
+  Bounds::List for_candidates(const Bounds* bounds, double motion, double threshold, Visit visit);
   template <class MakeRow>
   void add_friction_row(const Eigen::Vector3d& normal, double mu, const Eigen::Vector3d& obstacle_velocity, double lambda,
                         MakeRow row);
@@ -180,6 +183,7 @@ class BarrierPotential {
   std::vector<PairGeometry> cand_start_;
   std::vector<char> cand_start_known_;
   std::vector<char> cand_start_close_;
+  std::vector<size_t> start_close_;  // ... those, in increasing order
   std::vector<double> near_reach_of_;
 
   // Lower bounds of the candidates' distances at the step's start (start_bounds_) or at the end
@@ -204,6 +208,7 @@ class BarrierPotential {
   std::vector<size_t> closest_;
   std::vector<size_t> closest_set_;
   std::vector<PairGeometry> end_geometry_;
+  std::vector<char> end_known_;  // (which of end_geometry_ the last linearisation made)
 };
 
 }  // namespace clothsim::contact

@@ -8,8 +8,9 @@
 // positions) its Hessian blocks match central differences of the gradient; nothing acts farther
 // than the thickness; the step bound stops a triangle falling through another before the
 // separation (α ≤ 0.2 for a 0.5 mm gap closed by 2 mm, positions at 0.9 α uncrossed) and lets a
-// move away go whole; and the candidates are made again only when a point leaves the serve radius
-// (half the thickness) of the motion they were made for.
+// move away go whole; the candidates are made again only when a point leaves the serve radius
+// (half the thickness) of the motion they were made for; and of the broad phase's pairs over a fan
+// of long wedges exactly those closer than the boxes' growth are kept.
 //
 // Lengths [m], times [s], masses [kg]; the thickness d̂ is 1 mm.
 #include "sim/contact/barrier_potential.hpp"
@@ -20,6 +21,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <random>
@@ -291,6 +293,60 @@ TEST(BarrierPotential, CandidatesAreMadeAgainOnlyWhenAPointLeavesTheServeRadius)
   for (int k = 3; k < 6; ++k) moved(3 * k + 1) += 0.7e-3;
   s.begin(moved, still, 2 * kStep);
   EXPECT_EQ(s.potential->candidate_builds(), 3);
+}
+
+// A 10 cm fan of 48 long wedges in z = 0 (as the top of a meshed cylinder) under a 2 cm lattice
+// of 7 × 7 points 0.6 mm above it: the wedges' boxes overlap over much of the lattice.
+struct OverFan : Scene {
+  Eigen::VectorXd x;
+  static Obstacle fan() {
+    Obstacle o;
+    o.name = "fan";
+    o.shape = Obstacle::Shape::mesh;
+    o.mesh = testing::make_fan_disc(48, 1);
+    o.mesh.vertices *= 0.05;
+    return o;
+  }
+  static TriMesh lattice() {
+    TriMesh m = testing::make_lattice(7, 0.02);
+    m.vertices.col(0).array() -= 0.012;
+    m.vertices.col(1).array() -= 0.008;
+    m.vertices.col(2).setConstant(0.6e-3);
+    return m;
+  }
+  OverFan() : Scene(lattice(), {fan()}, false, Eigen::VectorXd::Constant(49, 1e-5)) { x = d.rest(); }
+};
+
+TEST(BarrierPotential, CandidatesFartherThanTheirGrowthAreDroppedAndNoneWithinIt) {
+  OverFan s;
+  const Eigen::VectorXd still = Eigen::VectorXd::Zero(s.x.size());
+  s.begin(s.x, still);
+  ASSERT_EQ(s.potential->candidate_builds(), 1);
+  // The broad phase's pairs for the same (still) motion with the same growth, and their exact
+  // distances at the start.
+  const double grow = kThickness + 2.0 * s.potential->serve_radius();
+  ContactCounters scratch;
+  const std::vector<Candidate> all = s.search->find(s.step.p0, s.step.p0, s.step.o0, s.step.o1, false, grow, scratch);
+  std::vector<Candidate> kept = s.potential->candidates();
+  std::sort(kept.begin(), kept.end());
+  int within = 0, beyond = 0;
+  for (const Candidate& c : all) {
+    const double distance = s.pairs.geometry(c, s.pairs.corners(c, s.step.p0, s.step.o0)).distance;
+    const bool is_kept = std::binary_search(kept.begin(), kept.end(), c);
+    if (distance < grow) {
+      ++within;
+      EXPECT_TRUE(is_kept) << "a pair " << distance << " m apart was dropped";
+    } else {
+      ++beyond;
+      EXPECT_FALSE(is_kept) << "a pair " << distance << " m apart was kept";
+    }
+  }
+  EXPECT_EQ(static_cast<size_t>(within), kept.size());
+  EXPECT_GT(beyond, within) << "the fan's boxes give more far pairs than near ones";
+  EXPECT_GT(within, 49) << "every point has its wedge";
+  // The barrier is unchanged by the dropped pairs: each point pressed by its closest wedge.
+  const PotentialLinearisation lin = s.linearise(still);
+  EXPECT_EQ(lin.active, 49);
 }
 
 }  // namespace
