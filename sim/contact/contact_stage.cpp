@@ -246,11 +246,11 @@ struct ContactStage::Impl {
     const std::vector<double>* lower = bounds != nullptr ? &bounds->lower : nullptr;
     const Bounds::List list =
         bounds != nullptr ? bounds->within(std::max(eta, params.near_separation_ratio * settings.thickness), motion) : Bounds::List{};
-    const size_t n = list.index != nullptr ? list.size : cands.size();
+    const size_t n = !list.all ? list.size : cands.size();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& range) {
       long long count = 0;
       for (size_t j = range.begin(); j != range.end(); ++j) {
-        const size_t i = list.index != nullptr ? list[j] : j;
+        const size_t i = !list.all ? list[j] : j;
         const Candidate& c = cands[i];
         const double separation = c.near ? params.near_separation_ratio * settings.thickness : eta;
         if (lower != nullptr && ((*lower)[i] - motion > separation ||

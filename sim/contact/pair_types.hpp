@@ -42,8 +42,9 @@ struct Candidate {
 // visits none of its tens of thousands of candidates, its linearisation those within the barrier's
 // reach).
 struct Bounds {
-  // A list of candidates: index[0 .. size).
+  // A list of candidates: index[0 .. size), or every candidate (`all`).
   struct List {
+    bool all = true;
     const size_t* index = nullptr;
     size_t size = 0;
     size_t operator[](size_t j) const { return index[j]; }
@@ -80,11 +81,10 @@ struct Bounds {
       if (level_[i] < levels) close[next[level_[i]]++] = i;
   }
   // The shortest list that holds every candidate whose distance may be below `threshold` after
-  // each pair's distance changed by at most `motion` [m]; none (index nullptr) when that may be
-  // any candidate.
+  // each pair's distance changed by at most `motion` [m]; `all` when that may be any candidate.
   List within(double threshold, double motion) const {
     for (size_t k = 0; k < reaches.size(); ++k)
-      if (reaches[k] - motion >= threshold) return List{close.data(), ends[k]};
+      if (reaches[k] - motion >= threshold) return List{false, close.data(), ends[k]};
     return List{};
   }
   // The bounds less `motion` (at least 0): the bounds after every point moved by at most that.

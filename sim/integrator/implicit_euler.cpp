@@ -91,6 +91,13 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
   const Eigen::Index n3 = v.size();
   auto clock = [] { return std::chrono::steady_clock::now(); };
   auto t0 = clock();
+  auto from_velocities = [&] {
+    for (Eigen::Index i = 0; i < n3; ++i)
+      if (free_[static_cast<size_t>(i)]) v(i) = v_now(i);
+  };
+  // (Where contact acted in the last step Newton starts from the step's velocities, below: the
+  // potential makes its candidates for that start's motion, not the guess's.)
+  if (first && contact_last_step_) from_velocities();
   if (first) potential_->begin_step(x, v, t, h, a.diagonal());
   // Newton starts where the surfaces have not passed through each other: the start's move of the
   // free components from the step's start positions is cut at the first crossing (the positions
@@ -111,11 +118,6 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
   // without trying the guess (the same start wherever the guess would have met contact too, one
   // cut and one linearisation less: sleeve_on_arm's contact 8.0 -> 7.1 s, same Newton iterations).
   PotentialLinearisation lin;
-  auto from_velocities = [&] {
-    for (Eigen::Index i = 0; i < n3; ++i)
-      if (free_[static_cast<size_t>(i)]) v(i) = v_now(i);
-  };
-  if (first && contact_last_step_) from_velocities();
   if (first) feasible(v);
   potential_->linearise(v, lin);
   if (!lin.empty()) potential_acted_ = true;

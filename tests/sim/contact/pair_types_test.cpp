@@ -27,9 +27,13 @@ TEST(DistanceBounds, CloseListsHoldTheBoundsBelowTheirReaches) {
   EXPECT_EQ(sorted(b.within(2.5, 0.0)), (std::vector<size_t>{0, 2, 3, 4}));
   // Each level in increasing order: below 0.1, then [0.1, 1.25), then [1.25, 2.5).
   EXPECT_EQ(b.close, (std::vector<size_t>{2, 0, 3, 4}));
-  b.make_close({0.0});  // nothing is below zero
+  b.make_close({0.0});  // nothing is below zero: an empty list, not all
   EXPECT_EQ(b.within(0.0, 0.0).size, 0u);
-  EXPECT_NE(b.within(0.0, 0.0).index, nullptr);
+  EXPECT_FALSE(b.within(0.0, 0.0).all);
+  Bounds none;  // no candidates at all
+  none.make_close({1.0});
+  EXPECT_FALSE(none.within(0.5, 0.0).all);
+  EXPECT_EQ(none.within(0.5, 0.0).size, 0u);
 }
 
 TEST(DistanceBounds, WithinPicksTheShortestListThatHoldsEveryPairThatCanComeBelowTheThreshold) {
@@ -42,12 +46,12 @@ TEST(DistanceBounds, WithinPicksTheShortestListThatHoldsEveryPairThatCanComeBelo
   EXPECT_EQ(b.within(1.0, 0.1).size, 3u);
   EXPECT_EQ(sorted(b.within(1.0, 0.1)), (std::vector<size_t>{0, 2, 3}));
   // Moves larger than every list allows: all candidates.
-  EXPECT_EQ(b.within(1.0, 0.5).index, nullptr);
+  EXPECT_TRUE(b.within(1.0, 0.5).all);
   // Every candidate that a list leaves out stays above the threshold.
   for (double threshold : {0.05, 0.1, 0.9, 1.0}) {
     for (double motion : {0.0, 0.01, 0.04, 0.2}) {
       const std::vector<size_t> list = sorted(b.within(threshold, motion));
-      if (b.within(threshold, motion).index == nullptr) continue;
+      if (b.within(threshold, motion).all) continue;
       for (size_t i = 0; i < b.lower.size(); ++i) {
         if (!std::binary_search(list.begin(), list.end(), i)) {
           EXPECT_GE(b.lower[i] - motion, threshold);
