@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -19,6 +20,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 #include <utility>
 
 namespace clothsim {
@@ -268,115 +270,132 @@ void validate_fold_plan(const FoldStudyPlan& plan) {
 
 // --- Running ------------------------------------------------------------------------------------
 
-std::vector<FoldRow> run_fold_study(const FoldStudyPlan& plan, const LogFn& log) {
+std::string FoldRun::id() const {
+  return case_name + "-" + method + "-" + std::to_string(mesh.segments) + "x" + std::to_string(mesh.rings) + "-seed" +
+         std::to_string(seed);
+}
+
+std::vector<FoldRun> fold_study_runs(const FoldStudyPlan& plan) {
+  validate_fold_plan(plan);
+  std::vector<FoldRun> runs;
+  for (const std::string& case_name : plan.cases)
+    for (const std::string& method : plan.methods)
+      for (const FoldMesh& mesh : plan.meshes)
+        for (int seed : plan.seeds) runs.push_back({case_name, method, mesh, seed});
+  return runs;
+}
+
+FoldRow run_fold_case(const FoldStudyPlan& plan, const FoldRun& run) {
   validate_fold_plan(plan);
   const ShellMaterial material = *material_preset(plan.preset);
   const double t_eff = effective_thickness(material);
   const double nu = material.poisson_ratio;
-  const int total = static_cast<int>(plan.cases.size() * plan.methods.size() * plan.meshes.size() * plan.seeds.size());
+  const std::filesystem::path file = plan.scenes_dir / scene_file_of(run.case_name);
+  const Json base = read_scene_json(file);
+  const SleeveShape shape = sleeve_shape(base, file);
+  const double end = plan.end.value_or(shape.end);
+  FoldBand circumferential{kNaN, kNaN}, axial{kNaN, kNaN};
+  if (run.case_name == "twist") {
+    circumferential = twist_circumferential_band(shape.radius, shape.length, t_eff);
+  } else {
+    circumferential = compression_circumferential_band(shape.radius, t_eff, nu);
+    axial = compression_axial_band(shape.radius, shape.length, t_eff, nu);
+  }
+  const double lambda = axisymmetric_buckling_wavelength(shape.radius, t_eff, nu);
+  const std::pair<double, double> wavelength =
+      plan.wavelength.value_or(std::make_pair(0.5 * lambda, 2.0 * std::numbers::pi * shape.radius));
+  const double amplitude = plan.amplitude.value_or(kDefaultAmplitudeFactor * t_eff);
+  const Eigen::Vector3d axis_point = Eigen::Vector3d::Zero(), axis_direction = Eigen::Vector3d::UnitY();
+
+  FoldRow row;
+  row.case_name = run.case_name;
+  row.method = run.method;
+  row.segments = run.mesh.segments;
+  row.rings = run.mesh.rings;
+  row.vertices = run.mesh.vertices();
+  row.seed = run.seed;
+  row.amplitude = amplitude;
+  row.dt = plan.dt;
+  row.circumferential_median = row.axial_median = kNaN;
+  row.circumferential_theory = circumferential;
+  row.axial_theory = axial;
+  row.t_eff = t_eff;
+  row.preset = plan.preset;
+  row.status = "ok";
+
+  Json j = base;
+  j["name"] = "fold_study_" + run.case_name;
+  j["method"] = run.method;
+  j["mesh"]["segments"] = run.mesh.segments;
+  j["mesh"]["rings"] = run.mesh.rings;
+  j["material"] = Json{{"preset", plan.preset}};
+  j["time"]["dt"] = plan.dt;
+  j["time"]["end"] = end;
+  j["imperfection"] = Json{{"amplitude", amplitude}, {"seed", run.seed},
+                           {"wavelength", {wavelength.first, wavelength.second}}};
+  if (plan.self_collision) {
+    if (!j.contains("collision")) j["collision"] = Json{{"self", true}};
+    else j["collision"]["self"] = true;
+  } else {
+    j.erase("collision");
+  }
+  j.erase("output");
+  // PCG with a Cholesky factor of an earlier step's matrix: the block-Jacobi default needs
+  // thousands of iterations per step on the fine meshes (and does not converge for the flat
+  // methods at 5 ms).
+  j["solver"]["preconditioner"] = "cholesky";
+  // The scene itself is the study's input: an error there stops the study.
+  const Problem problem = load_scene_text(j.dump(2), file, LogFn()).problem;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    Simulator sim(problem);
+    const int steps = sim.num_steps();
+    for (int k = 0; k < steps; ++k) {
+      sim.step();
+      ++row.steps;
+    }
+    row.end_time = sim.state().t;
+    const Eigen::VectorXd& x = sim.state().x;
+    if (!x.allFinite()) throw std::runtime_error("non-finite positions at the end");
+    const FoldCounts counts = count_drawn_folds(sim.discretization(), x, axis_point, axis_direction);
+    row.circumferential_median = counts.circumferential_median.value_or(kNaN);
+    row.axial_median = counts.axial_median.value_or(kNaN);
+    // A run that has not failed outright but left the sleeve's neighbourhood has blown up.
+    double reach = 0.0;
+    for (int n = 0; n < x.size() / 3; ++n) {
+      const Eigen::Vector3d p = x.segment<3>(3 * n);
+      reach = std::max({reach, std::hypot(p.x(), p.z()) / shape.radius, std::abs(p.y() - 0.5 * shape.length) /
+                                                                            (0.5 * shape.length)});
+    }
+    if (reach > 2.0) {
+      row.status = "unstable";
+      row.note = "a node ended " + format_fixed(reach, 1) +
+                 " x the radius (or half-length) from the sleeve's axis (or middle)";
+    }
+  } catch (const std::exception& e) {
+    row.status = "failed";
+    row.note = e.what();
+    row.circumferential_median = row.axial_median = kNaN;
+  }
+  row.wall_seconds = seconds_since(start);
+  return row;
+}
+
+std::vector<FoldRow> run_fold_study(const FoldStudyPlan& plan, const LogFn& log) {
+  const std::vector<FoldRun> runs = fold_study_runs(plan);
+  const int total = static_cast<int>(runs.size());
   int done = 0;
   std::vector<FoldRow> rows;
-  for (const std::string& case_name : plan.cases) {
-    const std::filesystem::path file = plan.scenes_dir / scene_file_of(case_name);
-    const Json base = read_scene_json(file);
-    const SleeveShape shape = sleeve_shape(base, file);
-    const double end = plan.end.value_or(shape.end);
-    FoldBand circumferential{kNaN, kNaN}, axial{kNaN, kNaN};
-    if (case_name == "twist") {
-      circumferential = twist_circumferential_band(shape.radius, shape.length, t_eff);
-    } else {
-      circumferential = compression_circumferential_band(shape.radius, t_eff, nu);
-      axial = compression_axial_band(shape.radius, shape.length, t_eff, nu);
-    }
-    const double lambda = axisymmetric_buckling_wavelength(shape.radius, t_eff, nu);
-    const std::pair<double, double> wavelength =
-        plan.wavelength.value_or(std::make_pair(0.5 * lambda, 2.0 * std::numbers::pi * shape.radius));
-    const double amplitude = plan.amplitude.value_or(kDefaultAmplitudeFactor * t_eff);
-    const Eigen::Vector3d axis_point = Eigen::Vector3d::Zero(), axis_direction = Eigen::Vector3d::UnitY();
-
-    for (const std::string& method : plan.methods)
-      for (const FoldMesh& mesh : plan.meshes)
-        for (int seed : plan.seeds) {
-          FoldRow row;
-          row.case_name = case_name;
-          row.method = method;
-          row.segments = mesh.segments;
-          row.rings = mesh.rings;
-          row.vertices = mesh.vertices();
-          row.seed = seed;
-          row.amplitude = amplitude;
-          row.dt = plan.dt;
-          row.circumferential_median = row.axial_median = kNaN;
-          row.circumferential_theory = circumferential;
-          row.axial_theory = axial;
-          row.t_eff = t_eff;
-          row.preset = plan.preset;
-          row.status = "ok";
-
-          Json j = base;
-          j["name"] = "fold_study_" + case_name;
-          j["method"] = method;
-          j["mesh"]["segments"] = mesh.segments;
-          j["mesh"]["rings"] = mesh.rings;
-          j["material"] = Json{{"preset", plan.preset}};
-          j["time"]["dt"] = plan.dt;
-          j["time"]["end"] = end;
-          j["imperfection"] = Json{{"amplitude", amplitude}, {"seed", seed},
-                                   {"wavelength", {wavelength.first, wavelength.second}}};
-          if (plan.self_collision) {
-            if (!j.contains("collision")) j["collision"] = Json{{"self", true}};
-            else j["collision"]["self"] = true;
-          } else {
-            j.erase("collision");
-          }
-          j.erase("output");
-          // PCG with a Cholesky factor of an earlier step's matrix: the block-Jacobi default needs
-          // thousands of iterations per step on the fine meshes (and does not converge for the flat
-          // methods at 5 ms).
-          j["solver"]["preconditioner"] = "cholesky";
-          // The scene itself is the study's input: an error there stops the study.
-          const Problem problem = load_scene_text(j.dump(2), file, LogFn()).problem;
-          const auto start = std::chrono::steady_clock::now();
-          try {
-            Simulator sim(problem);
-            const int steps = sim.num_steps();
-            for (int k = 0; k < steps; ++k) {
-              sim.step();
-              ++row.steps;
-            }
-            row.end_time = sim.state().t;
-            const Eigen::VectorXd& x = sim.state().x;
-            if (!x.allFinite()) throw std::runtime_error("non-finite positions at the end");
-            const FoldCounts counts = count_drawn_folds(sim.discretization(), x, axis_point, axis_direction);
-            row.circumferential_median = counts.circumferential_median.value_or(kNaN);
-            row.axial_median = counts.axial_median.value_or(kNaN);
-            // A run that has not failed outright but left the sleeve's neighbourhood has blown up.
-            double reach = 0.0;
-            for (int n = 0; n < x.size() / 3; ++n) {
-              const Eigen::Vector3d p = x.segment<3>(3 * n);
-              reach = std::max({reach, std::hypot(p.x(), p.z()) / shape.radius, std::abs(p.y() - 0.5 * shape.length) /
-                                                                                    (0.5 * shape.length)});
-            }
-            if (reach > 2.0) {
-              row.status = "unstable";
-              row.note = "a node ended " + format_fixed(reach, 1) +
-                         " x the radius (or half-length) from the sleeve's axis (or middle)";
-            }
-          } catch (const std::exception& e) {
-            row.status = "failed";
-            row.note = e.what();
-            row.circumferential_median = row.axial_median = kNaN;
-          }
-          row.wall_seconds = seconds_since(start);
-          ++done;
-          if (log)
-            log("[" + std::to_string(done) + "/" + std::to_string(total) + "] " + case_name + " " + method + " " +
-                std::to_string(mesh.segments) + "x" + std::to_string(mesh.rings) + " seed " + std::to_string(seed) +
-                ": circumferential " + count_text(row.circumferential_median) + ", axial " +
-                count_text(row.axial_median) + " (" + format_fixed(row.wall_seconds, 1) + " s" +
-                (row.status == "ok" ? "" : ", " + row.status + ": " + row.note) + ")");
-          rows.push_back(std::move(row));
-        }
+  for (const FoldRun& run : runs) {
+    FoldRow row = run_fold_case(plan, run);
+    ++done;
+    if (log)
+      log("[" + std::to_string(done) + "/" + std::to_string(total) + "] " + run.case_name + " " + run.method + " " +
+          std::to_string(run.mesh.segments) + "x" + std::to_string(run.mesh.rings) + " seed " +
+          std::to_string(run.seed) + ": circumferential " + count_text(row.circumferential_median) + ", axial " +
+          count_text(row.axial_median) + " (" + format_fixed(row.wall_seconds, 1) + " s" +
+          (row.status == "ok" ? "" : ", " + row.status + ": " + row.note) + ")");
+    rows.push_back(std::move(row));
   }
   return rows;
 }
@@ -404,6 +423,92 @@ void write_fold_csv(std::ostream& out, const std::vector<FoldRow>& rows) {
         << ',' << format_significant(r.axial_theory.lo, 6) << ',' << format_significant(r.axial_theory.hi, 6) << ','
         << format_significant(r.t_eff, 6) << ',' << csv_field(r.preset) << ',' << csv_field(r.status) << ','
         << csv_field(r.note) << '\n';
+}
+
+std::vector<FoldRow> read_fold_csv(const std::string& text) {
+  // Records of fields: quoted fields may hold commas, doubled quotes and line breaks.
+  std::vector<std::vector<std::string>> records;
+  std::vector<std::string> record;
+  std::string field;
+  bool quoted = false, any = false;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c != '"') field += c;
+      else if (i + 1 < text.size() && text[i + 1] == '"') field += text[++i];
+      else quoted = false;
+    } else if (c == '"') {
+      quoted = any = true;
+    } else if (c == ',') {
+      record.push_back(std::move(field));
+      field.clear();
+      any = true;
+    } else if (c == '\n') {
+      record.push_back(std::move(field));
+      field.clear();
+      records.push_back(std::move(record));
+      record.clear();
+      any = false;
+    } else {
+      field += c;
+      any = true;
+    }
+  }
+  if (quoted) throw std::invalid_argument("fold CSV: a quoted field is not closed");
+  if (any || !field.empty()) {
+    record.push_back(std::move(field));
+    records.push_back(std::move(record));
+  }
+  const std::vector<std::string>& columns = fold_csv_columns();
+  if (records.empty() || records.front() != columns)
+    throw std::invalid_argument("fold CSV: the first line is not the header of fold_csv_columns()");
+  std::vector<FoldRow> rows;
+  for (size_t line = 1; line < records.size(); ++line) {
+    const std::vector<std::string>& f = records[line];
+    auto fail = [&](size_t column, const std::string& what) {
+      throw std::invalid_argument("fold CSV: record " + std::to_string(line + 1) + ", column " +
+                                  (column < columns.size() ? columns[column] : std::to_string(column + 1)) + ": " +
+                                  what);
+    };
+    if (f.size() != columns.size())
+      fail(f.size(), std::to_string(f.size()) + " fields instead of " + std::to_string(columns.size()));
+    auto number = [&](size_t column) {
+      const std::string& s = f[column];
+      double v = 0.0;
+      const auto result = std::from_chars(s.data(), s.data() + s.size(), v);
+      if (result.ec != std::errc() || result.ptr != s.data() + s.size()) fail(column, "\"" + s + "\" is not a number");
+      return v;
+    };
+    auto whole = [&](size_t column) {
+      const std::string& s = f[column];
+      int v = 0;
+      const auto result = std::from_chars(s.data(), s.data() + s.size(), v);
+      if (result.ec != std::errc() || result.ptr != s.data() + s.size()) fail(column, "\"" + s + "\" is not an integer");
+      return v;
+    };
+    FoldRow r;
+    r.case_name = f[0];
+    r.method = f[1];
+    r.segments = whole(2);
+    r.rings = whole(3);
+    r.vertices = whole(4);
+    r.seed = whole(5);
+    r.amplitude = number(6);
+    r.dt = number(7);
+    r.steps = whole(8);
+    r.end_time = number(9);
+    r.wall_seconds = number(10);
+    r.circumferential_median = number(11);
+    r.axial_median = number(12);
+    r.circumferential_theory = {number(13), number(14)};
+    r.axial_theory = {number(15), number(16)};
+    r.t_eff = number(17);
+    r.preset = f[18];
+    r.status = f[19];
+    r.note = f[20];
+    rows.push_back(std::move(r));
+  }
+  return rows;
 }
 
 void write_fold_markdown(std::ostream& out, const std::vector<FoldRow>& rows) {

@@ -145,6 +145,26 @@ struct FoldRow {
   std::string note;          // the failure, or empty
 };
 
+// One run of a plan: a case, method, mesh and seed.
+struct FoldRun {
+  std::string case_name;
+  std::string method;
+  FoldMesh mesh;
+  int seed = 0;
+  // Its stable name, "<case>-<method>-<segments>x<rings>-seed<seed>" (e.g. "twist-loop_kl-13x9-seed1"):
+  // the same run has the same id in every plan (the plan's other settings are shared by all runs).
+  std::string id() const;
+};
+
+// The plan's runs in the order run_fold_study runs them (cases, then methods, meshes, seeds).
+// Throws std::invalid_argument for an invalid plan.
+std::vector<FoldRun> fold_study_runs(const FoldStudyPlan& plan);
+
+// Runs one run of the plan (as run_fold_study does) and returns its row; a failed run is a row
+// with status "failed". Throws std::invalid_argument for an invalid plan and SceneError for an
+// unreadable scene.
+FoldRow run_fold_case(const FoldStudyPlan& plan, const FoldRun& run);
+
 // Runs the plan (cases, then methods, meshes, seeds); progress lines to `log`. A failed run
 // (SimulationError, a non-finite state) is a row with status "failed", NaN counts and a note;
 // the study goes on. Throws std::invalid_argument for an invalid plan and SceneError for an
@@ -156,6 +176,10 @@ std::vector<FoldRow> run_fold_study(const FoldStudyPlan& plan, const LogFn& log)
 // circumferential_theory_hi, axial_theory_lo, axial_theory_hi, t_eff, preset, status, note.
 const std::vector<std::string>& fold_csv_columns();
 void write_fold_csv(std::ostream& out, const std::vector<FoldRow>& rows);
+// The rows of a CSV written by write_fold_csv (the header must be fold_csv_columns()); writing
+// them again gives the same text. Throws std::invalid_argument naming the line and column of a
+// malformed field.
+std::vector<FoldRow> read_fold_csv(const std::string& text);
 // Markdown: per case, method and mesh the seeds' counts (min–max and each), the theory band and
 // the mean wall time per run.
 void write_fold_markdown(std::ostream& out, const std::vector<FoldRow>& rows);
