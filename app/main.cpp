@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -193,9 +194,60 @@ int study_command(int argc, char** argv) {
       app.add_option("--amplitude", amplitude, "folds: imperfection amplitude [m] (default 0.5 t_eff)")->type_name("M"),
       app.add_option("--dt", dt, "folds: time step [s] (default 0.005)")->type_name("S"),
       app.add_option("--end", end, "folds: simulated time [s] (default 1, the end of the motion)")->type_name("S")};
+  // Plan / task / gather and the executors (app/sweep.hpp, docs/cluster.md): `study folds` only.
+  clothsim::SweepCommand sweep;
+  std::string plan_dir, gather_dir;
+  std::vector<CLI::Option*> sweep_options = {
+      app.add_option("--plan", plan_dir,
+                     "folds: write the runs as tasks to DIR (plan.json, tasks.tsv); alone, only plan (run each with\n"
+                     "`clothsim task DIR ID`); with --executor or -j, run them there and gather")
+          ->type_name("DIR"),
+      app.add_option("--gather", gather_dir,
+                     "folds: build the report from the tasks in DIR that finished (into the plan's --out unless\n"
+                     "--out is given), naming the missing and failed ones")
+          ->type_name("DIR"),
+      app.add_option("--executor", sweep.executor,
+                     "folds: run the tasks here (local, the default) or as a Slurm job array (slurm)")
+          ->check(CLI::IsMember({"local", "slurm"}))
+          ->type_name("local|slurm"),
+      app.add_option("-j,--jobs", sweep.jobs,
+                     "folds: tasks at once (local: processes, default 1, N > 1 with GNU parallel; slurm: the\n"
+                     "array throttle %N, default 32)")
+          ->check(CLI::Range(1, 100000))
+          ->type_name("N"),
+      app.add_flag("--retry-failed", sweep.retry_failed,
+                   "folds: run only the tasks of the plan in --plan DIR (default OUT/study_folds.tasks) that have\n"
+                   "no result, then gather"),
+      app.add_flag("--dry-run", sweep.dry_run, "folds, slurm: plan and print the job-array script without submitting"),
+      app.add_flag("--no-wait", sweep.no_wait, "folds, slurm: submit and return (gather later with --gather DIR)"),
+      app.add_option("--slurm-time", sweep.slurm_time, "folds, slurm: time limit per task")
+          ->type_name("[D-]HH:MM:SS")
+          ->capture_default_str(),
+      app.add_option("--slurm-mem", sweep.slurm_mem, "folds, slurm: memory per task")->type_name("SIZE")->capture_default_str(),
+      app.add_option("--partition", sweep.partition, "folds, slurm: the partition (sbatch --partition)")->type_name("NAME"),
+      app.add_option("--account", sweep.account, "folds, slurm: the account charged (sbatch --account)")->type_name("NAME"),
+      app.add_option("--sbatch-arg", sweep.sbatch_args,
+                     "folds, slurm: a further sbatch option for the script, e.g. --sbatch-arg=--qos=short (repeatable)")
+          ->type_name("OPTION")
+          ->allow_extra_args(false)};
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
   options.out_root = out;
   options.plot = !no_plot;
+  if (which != "folds")
+    for (const CLI::Option* o : sweep_options)
+      if (o->count() > 0) {
+        std::cerr << "clothsim: error: " << o->get_name()
+                  << " applies to `clothsim study folds` only (the other studies run in one process)\n";
+        return 1;
+      }
+  if (!plan_dir.empty()) sweep.plan = plan_dir;
+  if (!gather_dir.empty()) sweep.gather = gather_dir;
+  sweep.out_given = app.get_option("--out")->count() > 0;
+  {
+    std::error_code ec;
+    sweep.clothsim = std::filesystem::read_symlink("/proc/self/exe", ec);
+    if (ec) sweep.clothsim = argv[0];
+  }
   if (which != "folds")
     for (const CLI::Option* o : fold_options)
       if (o->count() > 0) {
@@ -206,9 +258,23 @@ int study_command(int argc, char** argv) {
     if (fold_options[5]->count() > 0) folds.amplitude = amplitude;
     if (fold_options[6]->count() > 0) folds.dt = dt;
     if (fold_options[7]->count() > 0) folds.end = end;
-    return clothsim::run_fold_study_report(options, folds);
+    return clothsim::run_fold_study_report(options, folds, sweep);
   }
   return which == "convergence" ? clothsim::run_convergence_study(options) : clothsim::run_stability_study(options);
+}
+
+// `clothsim task DIR ID`.
+int task_command(int argc, char** argv) {
+  CLI::App app{"clothsim task: runs one task of a study planned with `clothsim study folds --plan DIR` (its\n"
+               "line in DIR/tasks.tsv) into DIR/runs/ID/, published whole; a task that finished is not run\n"
+               "again, one another process is running is refused. Exit code 0 when the task has its result,\n"
+               "1 on an error (also written to DIR/failed/ID.txt). See docs/cluster.md.",
+               "clothsim task"};
+  std::string dir, id;
+  app.add_option("dir", dir, "The plan's folder")->required()->type_name("DIR");
+  app.add_option("id", id, "The task's id (second column of DIR/tasks.tsv)")->required()->type_name("ID");
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
+  return clothsim::run_sweep_task(dir, id);
 }
 
 // `clothsim figures [N ...] [--out DIR] [--size WxH] [--quick] [--rerun]`.
@@ -256,6 +322,7 @@ int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "render") return render_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "study") return study_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "figures") return figures_command(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "task") return task_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "compare") return compare_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "golden") return golden_command(argc, argv);
   CLI::App app{
@@ -270,7 +337,8 @@ int main(int argc, char** argv) {
       "  clothsim compare A B                        compare two PNGs, or two folders' PNGs\n"
       "  clothsim golden check|update MANIFEST       check or rewrite golden images of scenes\n"
       "  clothsim study convergence|stability|folds  write a report of README.md, \"Studies\"\n"
-      "  clothsim figures [N ...]                    the paper's Figs. 1, 7-11 (docs/figures.md)\n",
+      "  clothsim figures [N ...]                    the paper's Figs. 1, 7-11 (docs/figures.md)\n"
+      "  clothsim task DIR ID                        one task of a planned study (docs/cluster.md)\n",
       "clothsim"};
   std::string scene;
   std::string out = "out";

@@ -5,6 +5,9 @@
 // so a failed or interrupted study leaves an older report untouched.
 #pragma once
 
+#include "app/sweep.hpp"
+#include "sim/study/fold_study.hpp"
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -34,6 +37,12 @@ struct FoldStudyArgs {
   std::optional<double> dt;         // [s]
   std::optional<double> end;        // [s]
 };
-int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args);
+// Runs the study as `sweep` says (app/sweep.hpp: in this process, or planned, run by an executor and
+// gathered); the default SweepCommand is today's single process.
+int run_fold_study_report(const StudyOptions& options, const FoldStudyArgs& args, SweepCommand sweep = {});
+// The fold study's tasks (one per run, id FoldRun::id()) and report, for app/sweep.cpp.
+const SweepHooks& fold_sweep_hooks();
+// The plan as a sweep: its settings (plan.json) and the runs' ids in the plan's order.
+SweepStudy fold_study_sweep(const FoldStudyPlan& plan);
 
 }  // namespace clothsim
