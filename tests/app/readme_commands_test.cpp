@@ -136,6 +136,26 @@ const std::map<std::string, Form>& forms() {
        {{"{clothsim} study convergence --quick --no-plot --out {tmp}/studies"}, "{clothsim} study --help", ""}},
       {"clothsim study folds",
        {{"{clothsim} study folds --quick --no-plot --cases twist --out {tmp}/studies"}, "{clothsim} study --help", ""}},
+      // The fold study as tasks: plan, one task, the rest in this process (--executor local -j 1),
+      // gather; the Slurm script as a dry run (no Slurm needed). -j N > 1 and the Slurm executor:
+      // StudySweepCli.*, scripts/slurm_check.sh.
+      {"clothsim study folds --plan DIR",
+       {{"{clothsim} study folds --quick --no-plot --cases twist --methods mass_spring --plan {tmp}/sweep "
+         "--out {tmp}/sweep_out",
+         "{clothsim} task {tmp}/sweep twist-mass_spring-13x9-seed1",
+         "{clothsim} study folds --no-plot --plan {tmp}/sweep --retry-failed --executor local -j 1",
+         "{clothsim} study folds --no-plot --gather {tmp}/sweep",
+         "test -s {tmp}/sweep_out/study_folds/results.csv",
+         "{clothsim} study folds --quick --no-plot --cases twist --plan {tmp}/sweep_dry --executor slurm --dry-run "
+         "--slurm-time 10 --slurm-mem 1G --partition p --account a --sbatch-arg=--qos=low --no-wait"},
+        "{clothsim} study --help",
+        ""}},
+      {"clothsim task DIR ID",
+       {{"{clothsim} study folds --quick --no-plot --cases twist --methods mass_spring --plan {tmp}/task_plan",
+         "{clothsim} task {tmp}/task_plan twist-mass_spring-18x13-seed1",
+         "test -s {tmp}/task_plan/runs/twist-mass_spring-18x13-seed1/row.csv"},
+        "{clothsim} task --help",
+        ""}},
       // The quick stability study takes about 40 s; StudyStabilityCli.* runs it. Here: its options.
       {"clothsim study stability", {{}, "{clothsim} study --help", ""}},
       {"clothsim figures",
