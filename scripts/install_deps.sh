@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libpng-dev libosmesa6-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libcgal-dev
   python3-minimal python3-matplotlib python3-jsonschema
+  parallel  # clothsim study ... -j N (the local executor, docs/cluster.md)
   clang libclang-rt-14-dev llvm  # scripts/sanitize.sh: clang 14, its sanitizer and libFuzzer run-times, llvm-symbolizer
 )
 # Optional: PETSc 3.18 (with hypre's BoomerAMG and ML) for bench/multilevel_bench's comparison with
