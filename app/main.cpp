@@ -199,45 +199,46 @@ int study_command(int argc, char** argv) {
   std::string plan_dir, gather_dir;
   std::vector<CLI::Option*> sweep_options = {
       app.add_option("--plan", plan_dir,
-                     "folds: write the runs as tasks to DIR (plan.json, tasks.tsv); alone, only plan (run each with\n"
+                     "folds, stability: write the runs as tasks to DIR (plan.json, tasks.tsv); alone, only plan (run each with\n"
                      "`clothsim task DIR ID`); with --executor or -j, run them there and gather")
           ->type_name("DIR"),
       app.add_option("--gather", gather_dir,
-                     "folds: build the report from the tasks in DIR that finished (into the plan's --out unless\n"
+                     "folds, stability: build the report from the tasks in DIR that finished (into the plan's --out unless\n"
                      "--out is given), naming the missing and failed ones")
           ->type_name("DIR"),
       app.add_option("--executor", sweep.executor,
-                     "folds: run the tasks here (local, the default) or as a Slurm job array (slurm)")
+                     "folds, stability: run the tasks here (local, the default) or as a Slurm job array (slurm)")
           ->check(CLI::IsMember({"local", "slurm"}))
           ->type_name("local|slurm"),
       app.add_option("-j,--jobs", sweep.jobs,
-                     "folds: tasks at once (local: processes, default 1, N > 1 with GNU parallel; slurm: the\n"
+                     "folds, stability: tasks at once (local: processes, default 1, N > 1 with GNU parallel; slurm: the\n"
                      "array throttle %N, default 32)")
           ->check(CLI::Range(1, 100000))
           ->type_name("N"),
       app.add_flag("--retry-failed", sweep.retry_failed,
-                   "folds: run only the tasks of the plan in --plan DIR (default OUT/study_folds.tasks) that have\n"
+                   "folds, stability: run only the tasks of the plan in --plan DIR (default OUT/study_NAME.tasks) that have\n"
                    "no result, then gather"),
-      app.add_flag("--dry-run", sweep.dry_run, "folds, slurm: plan and print the job-array script without submitting"),
-      app.add_flag("--no-wait", sweep.no_wait, "folds, slurm: submit and return (gather later with --gather DIR)"),
-      app.add_option("--slurm-time", sweep.slurm_time, "folds, slurm: time limit per task")
+      app.add_flag("--dry-run", sweep.dry_run, "slurm: plan and print the job-array script without submitting"),
+      app.add_flag("--no-wait", sweep.no_wait, "slurm: submit and return (gather later with --gather DIR)"),
+      app.add_option("--slurm-time", sweep.slurm_time, "slurm: time limit per task")
           ->type_name("[D-]HH:MM:SS")
           ->capture_default_str(),
-      app.add_option("--slurm-mem", sweep.slurm_mem, "folds, slurm: memory per task")->type_name("SIZE")->capture_default_str(),
-      app.add_option("--partition", sweep.partition, "folds, slurm: the partition (sbatch --partition)")->type_name("NAME"),
-      app.add_option("--account", sweep.account, "folds, slurm: the account charged (sbatch --account)")->type_name("NAME"),
+      app.add_option("--slurm-mem", sweep.slurm_mem, "slurm: memory per task")->type_name("SIZE")->capture_default_str(),
+      app.add_option("--partition", sweep.partition, "slurm: the partition (sbatch --partition)")->type_name("NAME"),
+      app.add_option("--account", sweep.account, "slurm: the account charged (sbatch --account)")->type_name("NAME"),
       app.add_option("--sbatch-arg", sweep.sbatch_args,
-                     "folds, slurm: a further sbatch option for the script, e.g. --sbatch-arg=--qos=short (repeatable)")
+                     "slurm: a further sbatch option for the script, e.g. --sbatch-arg=--qos=short (repeatable)")
           ->type_name("OPTION")
           ->allow_extra_args(false)};
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
   options.out_root = out;
   options.plot = !no_plot;
-  if (which != "folds")
+  if (which == "convergence")
     for (const CLI::Option* o : sweep_options)
       if (o->count() > 0) {
         std::cerr << "clothsim: error: " << o->get_name()
-                  << " applies to `clothsim study folds` only (the other studies run in one process)\n";
+                  << " applies to `clothsim study folds` and `study stability` only (the convergence study runs in "
+                     "one process)\n";
         return 1;
       }
   if (!plan_dir.empty()) sweep.plan = plan_dir;
@@ -260,7 +261,8 @@ int study_command(int argc, char** argv) {
     if (fold_options[7]->count() > 0) folds.end = end;
     return clothsim::run_fold_study_report(options, folds, sweep);
   }
-  return which == "convergence" ? clothsim::run_convergence_study(options) : clothsim::run_stability_study(options);
+  return which == "convergence" ? clothsim::run_convergence_study(options)
+                                : clothsim::run_stability_study(options, sweep);
 }
 
 // `clothsim task DIR ID`.

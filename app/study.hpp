@@ -22,7 +22,10 @@ struct StudyOptions {
 
 // Return the process exit code: 0 on success, 1 on error (message on stderr, "clothsim: error: ...").
 int run_convergence_study(const StudyOptions& options);
-int run_stability_study(const StudyOptions& options);
+int run_stability_study(const StudyOptions& options, SweepCommand sweep = {});
+// The stability matrix's tasks (one per case, id: its name; result.json) and report.
+const SweepHooks& stability_sweep_hooks();
+SweepStudy stability_study_sweep(bool quick);
 
 // `clothsim study folds` (app/study_folds.cpp, docs/fold_study.md): the options that rerun it
 // differently. Empty strings / unset values keep the plan's defaults (the full plan, or the quick

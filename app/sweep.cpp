@@ -6,6 +6,7 @@
 #include "sim/study/report_format.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -69,10 +70,11 @@ std::string host_name() {
 fs::path log_file(const fs::path& dir, int index) { return dir / "logs" / ("task_" + std::to_string(index) + ".log"); }
 
 // Runs argv (argv[0] looked up on $PATH) with stdout and stderr to `output` (empty: inherited) and
-// waits; calls `poll` every half second meanwhile. Returns the exit status (128 + signal when
-// killed), or -1 with `error` set when it cannot be started.
+// waits; calls `poll` every half second meanwhile, and when it returns true stops waiting: the
+// process is sent SIGTERM and the result is 0. Returns the exit status (128 + signal when killed),
+// or -1 with `error` set when it cannot be started.
 int run_process(const std::vector<std::string>& argv, const fs::path& output, std::string& error,
-                const std::function<void()>& poll = {}) {
+                const std::function<bool()>& poll = {}) {
   std::vector<std::string> storage = argv;
   std::vector<char*> args;
   for (std::string& a : storage) args.push_back(a.data());
@@ -102,7 +104,12 @@ int run_process(const std::vector<std::string>& argv, const fs::path& output, st
       return -1;
     }
     if (done == 0) {
-      poll();
+      if (poll()) {
+        ::kill(pid, SIGTERM);
+        while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+        }
+        return 0;
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(500));
     }
   }
@@ -153,27 +160,39 @@ std::optional<TaskTimes> task_times(const fs::path& dir, const std::string& id) 
   }
 }
 
-// "N tasks in W s (sum of the tasks' own times S s, at most C at once): about O s per task of
-// overhead", from the task.json of `ids`; empty when none of them finished.
-std::string overhead_line(const fs::path& dir, const std::vector<std::string>& ids, double wall) {
-  std::vector<std::pair<double, int>> events;
+// "N tasks in W s (their own times add up to S s, at most C at once): about O s of dispatch
+// overhead per task", from the task.json of `ids`, the executor having started at `start` (epoch
+// seconds) and run `wall` seconds; empty when none of them finished. The overhead of a task is
+// the time from the moment a slot was free (at the start, or when an earlier task ended there)
+// to its start, the slots being the most tasks seen running at once.
+std::string overhead_line(const fs::path& dir, const std::vector<std::string>& ids, double start, double wall) {
+  std::vector<TaskTimes> tasks;
   double sum = 0.0;
-  int n = 0;
   for (const std::string& id : ids)
     if (const auto t = task_times(dir, id)) {
+      tasks.push_back(*t);
       sum += t->seconds;
-      events.push_back({t->start, 1});
-      events.push_back({t->end, -1});
-      ++n;
     }
-  if (n == 0) return "";
+  if (tasks.empty()) return "";
+  std::vector<std::pair<double, int>> events;
+  for (const TaskTimes& t : tasks) {
+    events.push_back({t.start, 1});
+    events.push_back({t.end, -1});
+  }
   std::sort(events.begin(), events.end());
   int running = 0, most = 0;
   for (const auto& e : events) most = std::max(most, running += e.second);
-  const double overhead = (wall * most - sum) / n;
-  return std::to_string(n) + " tasks in " + format_fixed(wall, 1) + " s (their own times add up to " +
+  std::sort(tasks.begin(), tasks.end(), [](const TaskTimes& a, const TaskTimes& b) { return a.start < b.start; });
+  std::vector<double> free_at(static_cast<size_t>(std::max(1, most)), start);  // when each slot is free
+  double delay = 0.0;
+  for (const TaskTimes& t : tasks) {
+    auto slot = std::min_element(free_at.begin(), free_at.end());
+    delay += std::max(0.0, t.start - *slot);
+    *slot = t.end;
+  }
+  return std::to_string(tasks.size()) + " tasks in " + format_fixed(wall, 1) + " s (their own times add up to " +
          format_fixed(sum, 1) + " s, at most " + std::to_string(most) + " at once): about " +
-         format_fixed(std::max(0.0, overhead), 2) + " s of overhead per task";
+         format_fixed(delay / static_cast<double>(tasks.size()), 2) + " s of dispatch overhead per task";
 }
 
 std::string resume_command(const std::string& name, const fs::path& dir, const SweepCommand& c) {
@@ -200,7 +219,8 @@ void log_line(const std::string& line) { std::cerr << "clothsim: " << line << st
 
 const SweepHooks& sweep_hooks(const std::string& name) {
   if (name == "folds") return fold_sweep_hooks();
-  throw std::invalid_argument("study \"" + name + "\" cannot be run as tasks (only folds can)");
+  if (name == "stability") return stability_sweep_hooks();
+  throw std::invalid_argument("study \"" + name + "\" cannot be run as tasks (only folds and stability can)");
 }
 
 std::filesystem::path find_on_path(const std::string& name) {
@@ -594,7 +614,7 @@ int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const Swee
   std::string job;
   const double start = epoch_seconds();
   auto last_report = std::chrono::steady_clock::now();
-  int last_done = -1;
+  int last_done = -1, polls = 0;
   auto poll = [&] {
     if (job.empty()) {
       std::string text;
@@ -616,10 +636,14 @@ int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const Swee
         log_line("slurm: " + std::to_string(done) + " of " + std::to_string(pending.size()) + " tasks finished");
       last_done = done;
     }
+    // Every task has its result: stop waiting for sbatch --wait, which notices the end of the
+    // array only at its next poll of the controller (up to 30 s later; the array is not cancelled).
+    return !job.empty() && !c.no_wait && ++polls % 4 == 0 &&
+           count_finished(plan, pending) == static_cast<int>(pending.size());
   };
   std::string error;
   const int code = run_process(argv, submit_out, error, poll);
-  poll();
+  poll();  // the job id, if sbatch returned before the first poll
   const double wall = epoch_seconds() - start;
   if (code < 0) {
     std::cerr << "clothsim: error: --executor slurm: " << error << '\n';
@@ -644,14 +668,13 @@ int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const Swee
               << (c.plot ? "" : " --no-plot") << '\n';
     return 2;
   }
-  // The overhead is measured up to the end of the last task: sbatch --wait notices the end of the
-  // array only at its next poll (up to 10 s later).
+  // The overhead is measured up to the end of the last task.
   double last_end = start;
   for (int i : pending)
     if (const auto t = task_times(plan.dir, plan.ids[i])) last_end = std::max(last_end, t->end);
-  if (const std::string line = overhead_line(plan.dir, ids_of(plan, pending), last_end - start); !line.empty())
+  if (const std::string line = overhead_line(plan.dir, ids_of(plan, pending), start, last_end - start); !line.empty())
     std::cout << "slurm: job array " << job << ": " << line << "; " << format_fixed(wall, 1)
-              << " s from submission to sbatch's return\n";
+              << " s from submission to the end of the wait\n";
   if (code != 0) log_line("slurm: job array " + job + " ended with exit status " + std::to_string(code) + " (some task failed)");
   return 0;
 }
@@ -691,7 +714,7 @@ int run_study_command(const std::string& name, const std::function<SweepStudy()>
     for (size_t i = 0; i < study.ids.size(); ++i) {
       const std::string tag = "[" + std::to_string(i + 1) + "/" + std::to_string(study.ids.size()) + "] " + study.ids[i];
       input.results[study.ids[i]] =
-          hooks.run(study.settings, study.ids[i], [&](const std::string& line) { log_line(name + ": " + tag + ": " + line); });
+          hooks.run(study.settings, study.ids[i], [&](const std::string& line) { log_line(tag + ": " + line); });
     }
     input.seconds = elapsed();
     return hooks.gather(study.settings, input);
@@ -744,10 +767,11 @@ int run_study_command(const std::string& name, const std::function<SweepStudy()>
       if (code == 1) return 1;
       if (code == 2) return 0;
     } else {
-      const double before = elapsed();
+      const double before = elapsed(), before_epoch = epoch_seconds();
       if (!run_local(plan, pending, c)) return 1;
       if (c.jobs > 1)
-        if (const std::string line = overhead_line(plan.dir, ids_of(plan, pending), elapsed() - before); !line.empty())
+        if (const std::string line = overhead_line(plan.dir, ids_of(plan, pending), before_epoch, elapsed() - before);
+            !line.empty())
           std::cout << "local: " << line << '\n';
     }
   }

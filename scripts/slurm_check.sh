@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# CI check of issue 31: the quick fold study run serially, with the local executor (-j 2) and as a
-# Slurm job array on a one-node cluster started here (scripts/slurm_local.sh, as root) gives the
-# same results.csv in every column but wall_seconds. Prints the wall times and Slurm's overhead
-# per task. Needs a built build/release/clothsim (scripts/test.sh) or CLOTHSIM_BIN.
+# CI check of issue 31: the quick fold study and the quick stability matrix, each run serially,
+# with the local executor (-j 2) and as a Slurm job array on a one-node cluster started here
+# (scripts/slurm_local.sh, as root), give the same results.csv in every column but wall_seconds.
+# Prints the wall times and Slurm's dispatch overhead per task. Needs a built build/release/clothsim (scripts/test.sh) or CLOTHSIM_BIN.
 # Usage: scripts/slurm_check.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,46 +15,57 @@ cleanup() {
   rm -rf "$tmp"
 }
 trap cleanup EXIT
-export SLURM_CONF="${CLOTHSIM_SLURM_DIR:-/run/clothsim-slurm}/slurm.conf"
+slurm_dir="${CLOTHSIM_SLURM_DIR:-/run/clothsim-slurm}"
+export SLURM_CONF="$slurm_dir/slurm.conf"
+now() { date +%s.%N; }
+since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
 
-study=(study folds --quick --no-plot)
-t=$SECONDS
-"$bin" "${study[@]}" --out "$tmp/serial" 2>"$tmp/serial.log"
-serial=$((SECONDS - t))
-t=$SECONDS
-"$bin" "${study[@]}" -j 2 --out "$tmp/local" 2>"$tmp/local.log" | tee "$tmp/local.out"
-local_j2=$((SECONDS - t))
-
-t=$SECONDS
-if [ -f "$SLURM_CONF" ] && sinfo -h >/dev/null 2>&1; then
+t=$(now)
+if [ -s "$slurm_dir/slurmctld.pid" ] && kill -0 "$(cat "$slurm_dir/slurmctld.pid")" 2>/dev/null; then
   echo "slurm_check: using the running cluster ($SLURM_CONF)"
 else
   started=1
   scripts/slurm_local.sh start
 fi
-cluster=$((SECONDS - t))
-t=$SECONDS
-"$bin" "${study[@]}" --executor slurm --slurm-time 10 --slurm-mem 1G --out "$tmp/slurm" 2>"$tmp/slurm.log" |
-  tee "$tmp/slurm.out" || { cat "$tmp/slurm.log" >&2; exit 1; }
-slurm=$((SECONDS - t))
+cluster=$(since "$t")
+
+summary=""
+for name in folds stability; do
+  study=(study "$name" --quick --no-plot)
+  t=$(now)
+  "$bin" "${study[@]}" --out "$tmp/serial" 2>"$tmp/serial_$name.log" >/dev/null
+  serial=$(since "$t")
+  t=$(now)
+  "$bin" "${study[@]}" -j 2 --out "$tmp/local" 2>"$tmp/local_$name.log" | grep '^local:' ||
+    { cat "$tmp/local_$name.log" >&2; exit 1; }
+  local_j2=$(since "$t")
+  t=$(now)
+  "$bin" "${study[@]}" --executor slurm --slurm-time 10 --slurm-mem 1G --out "$tmp/slurm" 2>"$tmp/slurm_$name.log" |
+    grep '^slurm:' || { cat "$tmp/slurm_$name.log" >&2; exit 1; }
+  slurm=$(since "$t")
+  summary+="slurm_check: quick $name study wall times: serial $serial s, local -j 2 $local_j2 s, slurm $slurm s"$'\n'
+done
 
 # results.csv without wall_seconds, compared with the serial run's.
 /usr/bin/python3 - "$tmp" <<'PY'
 import csv, sys
 tmp = sys.argv[1]
-def rows(name):
-    with open(f"{tmp}/{name}/study_folds/results.csv", newline="") as f:
+def rows(run, study):
+    with open(f"{tmp}/{run}/study_{study}/results.csv", newline="") as f:
         table = list(csv.reader(f))
     drop = table[0].index("wall_seconds")
     return [r[:drop] + r[drop + 1:] for r in table]
-serial = rows("serial")
-for other in ("local", "slurm"):
-    got = rows(other)
-    if got != serial:
-        for a, b in zip(serial, got):
-            if a != b:
-                print(f"slurm_check: {other} differs from serial:\n  {a}\n  {b}", file=sys.stderr)
-        sys.exit(f"slurm_check: error: {other}/study_folds/results.csv is not the serial run's ({len(got) - 1} rows)")
-print(f"slurm_check: results.csv of -j 2 and of slurm equal the serial run's ({len(serial) - 1} rows, every column but wall_seconds)")
+for study in ("folds", "stability"):
+    serial = rows("serial", study)
+    for other in ("local", "slurm"):
+        got = rows(other, study)
+        if got != serial:
+            for a, b in zip(serial, got):
+                if a != b:
+                    print(f"slurm_check: {other} differs from serial:\n  {a}\n  {b}", file=sys.stderr)
+            sys.exit(f"slurm_check: error: {other}/study_{study}/results.csv is not the serial run's")
+    print(f"slurm_check: {study}: results.csv of -j 2 and of slurm equal the serial run's "
+          f"({len(serial) - 1} rows, every column but wall_seconds)")
 PY
-echo "slurm_check: quick fold study wall times: serial ${serial} s, local -j 2 ${local_j2} s, slurm ${slurm} s (cluster start ${cluster} s)"
+printf '%s' "$summary"
+echo "slurm_check: cluster start $cluster s"

@@ -4,7 +4,8 @@
 // in every column but the times; --executor slurm without sbatch on the PATH, with a submission
 // sbatch rejects, and as a dry run; a stand-in sbatch that runs the array here but leaves one
 // task out, the gather naming it and the printed --retry-failed command finishing the study; bad
-// plan folders and sweep options on other studies are errors.
+// plan folders and sweep options on the convergence study are errors; the stability matrix
+// planned, two cases run by hand and gathered, the others named.
 #include "tests/support/cli_fixture.hpp"
 
 #include <gtest/gtest.h>
@@ -191,6 +192,39 @@ TEST_F(StudySweepCli, AMissingTaskIsNamedAndTheRetryCommandFinishesTheStudy) {
   EXPECT_TRUE(contains(second.out, "fold study: 4 runs (0 failed or unstable)")) << second.out;
 }
 
+TEST_F(StudySweepCli, StabilityTasksAreGatheredAndTheMissingCasesNamed) {
+  // The quick matrix planned; two of its fast cases run by hand, in reverse order.
+  const fs::path plan = dir_ / "plan";
+  const CliResult planned = run("study stability --quick --no-plot --plan " + q(plan) + " --out " + q(dir_ / "out"));
+  ASSERT_EQ(planned.exit_code, 0) << planned.err;
+  EXPECT_TRUE(contains(planned.out, "planned 9 tasks of study stability")) << planned.out;
+  for (const char* id : {"mesh_coarse_90_dt_5e-2", "material_Et_1e7_dt_5e-2"}) {
+    const CliResult task = run("task " + q(plan) + " " + id);
+    ASSERT_EQ(task.exit_code, 0) << task.err;
+  }
+  const CliResult gathered = run("study stability --no-plot --gather " + q(plan));
+  EXPECT_EQ(gathered.exit_code, 1);
+  EXPECT_TRUE(contains(gathered.out, "stability study: 2 of 2 cases pass")) << gathered.out;
+  EXPECT_TRUE(contains(gathered.err, "7 of 9 tasks did not finish")) << gathered.err;
+  EXPECT_TRUE(contains(gathered.err, "dt_1e-2 (task 0): it did not run")) << gathered.err;
+  const fs::path report = dir_ / "out" / "study_stability";
+  const std::string csv = read_file_bytes(report / "results.csv");
+  // In the plan's order (material_Et_1e7_dt_5e-2 is task 3, mesh_coarse_90_dt_5e-2 task 7).
+  const size_t a = csv.find("\nmaterial_Et_1e7_dt_5e-2,true,false,"), b = csv.find("\nmesh_coarse_90_dt_5e-2,true,false,");
+  EXPECT_NE(a, std::string::npos) << csv;
+  EXPECT_NE(b, std::string::npos) << csv;
+  EXPECT_LT(a, b) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;
+  EXPECT_TRUE(contains(read_file_bytes(report / "table.md"), "## Cases that did not finish"));
+  // Every case's scene is written, finished or not.
+  EXPECT_TRUE(fs::exists(report / "scenes" / "dt_1e-2.json"));
+  // Gathering again gives the same files.
+  const std::string table = read_file_bytes(report / "table.md");
+  EXPECT_EQ(run("study stability --no-plot --gather " + q(plan)).exit_code, 1);
+  EXPECT_EQ(read_file_bytes(report / "results.csv"), csv);
+  EXPECT_EQ(read_file_bytes(report / "table.md"), table);
+}
+
 TEST_F(StudySweepCli, BadFoldersAndOptionsAreErrors) {
   const CliResult gather = run("study folds --gather " + q(dir_));
   EXPECT_EQ(gather.exit_code, 1);
@@ -202,9 +236,10 @@ TEST_F(StudySweepCli, BadFoldersAndOptionsAreErrors) {
   EXPECT_TRUE(contains(full.err, "is not empty")) << full.err;
   EXPECT_EQ(read_file_bytes(dir_ / "full" / "keep.txt"), "mine");
 
-  const CliResult other = run("study stability --quick -j 2 --out " + q(dir_ / "s"));
+  const CliResult other = run("study convergence --quick -j 2 --out " + q(dir_ / "s"));
   EXPECT_EQ(other.exit_code, 1);
-  EXPECT_TRUE(contains(other.err, "applies to `clothsim study folds` only")) << other.err;
+  EXPECT_TRUE(contains(other.err, "applies to `clothsim study folds` and `study stability` only")) << other.err;
+  EXPECT_FALSE(fs::exists(dir_ / "s"));
 
   const CliResult mixed = run("study folds --quick --gather " + q(dir_));
   EXPECT_EQ(mixed.exit_code, 1);
