@@ -137,9 +137,9 @@ const std::map<std::string, Form>& forms() {
       {"clothsim study folds",
        {{"{clothsim} study folds --quick --no-plot --cases twist --out {tmp}/studies"}, "{clothsim} study --help", ""}},
       // The fold study as tasks: plan, one task, the rest in this process (--executor local -j 1),
-      // gather; the Slurm script as a dry run (no Slurm needed). -j N > 1 and the Slurm executor:
-      // StudySweepCli.*, scripts/slurm_check.sh.
-      {"clothsim study folds --plan DIR",
+      // gather; the Slurm scripts of both studies as dry runs (no Slurm needed). -j N > 1, the
+      // stability tasks and the Slurm executor: StudySweepCli.*, scripts/slurm_check.sh.
+      {"clothsim study folds\\|stability --plan DIR",
        {{"{clothsim} study folds --quick --no-plot --cases twist --methods mass_spring --plan {tmp}/sweep "
          "--out {tmp}/sweep_out",
          "{clothsim} task {tmp}/sweep twist-mass_spring-13x9-seed1",
@@ -147,7 +147,8 @@ const std::map<std::string, Form>& forms() {
          "{clothsim} study folds --no-plot --gather {tmp}/sweep",
          "test -s {tmp}/sweep_out/study_folds/results.csv",
          "{clothsim} study folds --quick --no-plot --cases twist --plan {tmp}/sweep_dry --executor slurm --dry-run "
-         "--slurm-time 10 --slurm-mem 1G --partition p --account a --sbatch-arg=--qos=low --no-wait"},
+         "--slurm-time 10 --slurm-mem 1G --partition p --account a --sbatch-arg=--qos=low --no-wait",
+         "{clothsim} study stability --quick --no-plot --plan {tmp}/stability_dry --executor slurm --dry-run"},
         "{clothsim} study --help",
         ""}},
       {"clothsim task DIR ID",
