@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <csignal>
 #include <cerrno>
 #include <chrono>
 #include <cstdlib>
@@ -576,8 +577,12 @@ bool run_local(const SweepPlan& plan, const std::vector<int>& pending, const Swe
   return true;
 }
 
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void note_interrupt(int) { g_interrupted = 1; }
+
 // The Slurm executor. Returns 0 when the array ran (the gather follows), 2 when it is submitted
-// and not waited for, 1 on an error (message printed).
+// and not waited for, 3 when the wait was interrupted (SIGINT, SIGTERM: the array goes on), 1 on
+// an error (message printed).
 int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const SweepCommand& c, const std::string& resume) {
   const std::string script = slurm_array_script(plan, pending, c);
   const fs::path script_file = plan.dir / "slurm_array.sh";
@@ -642,9 +647,32 @@ int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const Swee
            count_finished(plan, pending) == static_cast<int>(pending.size());
   };
   std::string error;
-  const int code = run_process(argv, submit_out, error, poll);
+  // Ctrl-C or SIGTERM while waiting ends the wait, not the array.
+  struct sigaction on_signal = {}, old_int = {}, old_term = {};
+  on_signal.sa_handler = note_interrupt;
+  sigemptyset(&on_signal.sa_mask);
+  g_interrupted = 0;
+  ::sigaction(SIGINT, &on_signal, &old_int);
+  ::sigaction(SIGTERM, &on_signal, &old_term);
+  const int code = run_process(argv, submit_out, error, [&] { return poll() || g_interrupted != 0; });
+  ::sigaction(SIGINT, &old_int, nullptr);
+  ::sigaction(SIGTERM, &old_term, nullptr);
   poll();  // the job id, if sbatch returned before the first poll
   const double wall = epoch_seconds() - start;
+  if (g_interrupted) {
+    const std::string gather = "clothsim study " + plan.study + " --gather " + shell_word(plan.dir.string()) +
+                               (c.out_given ? " --out " + shell_word(c.out_root.string()) : "") +
+                               (c.plot ? "" : " --no-plot");
+    if (job.empty())
+      std::cerr << "clothsim: interrupted while submitting; `squeue -u $USER` shows whether the array was submitted. "
+                << "Gather what finished with: " << gather << '\n';
+    else
+      std::cerr << "clothsim: interrupted; job array " << job << " goes on running on the cluster (squeue -j " << job
+                << "; `scancel " << job << "` stops it). " << count_finished(plan, pending) << " of " << pending.size()
+                << " tasks have finished so far. When it has ended, gather with: " << gather
+                << "\nand run what did not finish with: " << resume << '\n';
+    return 3;
+  }
   if (code < 0) {
     std::cerr << "clothsim: error: --executor slurm: " << error << '\n';
     return 1;
@@ -766,6 +794,7 @@ int run_study_command(const std::string& name, const std::function<SweepStudy()>
       const int code = run_slurm(plan, pending, c, resume);
       if (code == 1) return 1;
       if (code == 2) return 0;
+      if (code == 3) return 130;
     } else {
       const double before = elapsed(), before_epoch = epoch_seconds();
       if (!run_local(plan, pending, c)) return 1;

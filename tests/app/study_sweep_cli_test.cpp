@@ -3,7 +3,8 @@
 // `--plan` + `clothsim task` per line of tasks.tsv + `--gather` give the serial run's results.csv
 // in every column but the times; --executor slurm without sbatch on the PATH, with a submission
 // sbatch rejects, and as a dry run; a stand-in sbatch that runs the array here but leaves one
-// task out, the gather naming it and the printed --retry-failed command finishing the study; bad
+// task out, the gather naming it and the printed --retry-failed command finishing the study; an
+// interrupted wait (the array goes on; the gather command printed); bad
 // plan folders and sweep options on the convergence study are errors; the stability matrix
 // planned, two cases run by hand and gathered, the others named.
 #include "tests/support/cli_fixture.hpp"
@@ -190,6 +191,24 @@ TEST_F(StudySweepCli, AMissingTaskIsNamedAndTheRetryCommandFinishesTheStudy) {
   EXPECT_TRUE(contains(second.err, "1 of 4 tasks to run")) << second.err;
   EXPECT_TRUE(contains(read_file_bytes(plan / "slurm_array.sh"), "#SBATCH --array=2%32\n"));
   EXPECT_TRUE(contains(second.out, "fold study: 4 runs (0 failed or unstable)")) << second.out;
+}
+
+TEST_F(StudySweepCli, AnInterruptedWaitLeavesTheArrayAndSaysHowToGather) {
+  // A stand-in sbatch that accepts the array and then waits (a long job).
+  write("slow/sbatch", "#!/bin/bash\necho 42\nexec sleep 60\n");
+  fs::permissions(dir_ / "slow" / "sbatch", fs::perms::owner_all);
+  const fs::path plan = dir_ / "plan";
+  CliResult r;
+  r.exit_code = run_shell("{ PATH=" + (dir_ / "slow").string() + ":/usr/bin:/bin " +
+                          testing::shell_quote(CLOTHSIM_BINARY) + " " + kPlan + " --executor slurm --plan " + q(plan) +
+                          " --out " + q(dir_ / "out") + " & p=$!; sleep 2; kill -INT $p; wait $p; } >" + q(dir_ / ".o") +
+                          " 2>" + q(dir_ / ".e"));
+  r.err = read_file_bytes(dir_ / ".e");
+  EXPECT_EQ(r.exit_code, 130) << r.err;
+  EXPECT_TRUE(contains(r.err, "interrupted; job array 42 goes on running")) << r.err;
+  EXPECT_TRUE(contains(r.err, "scancel 42")) << r.err;
+  EXPECT_TRUE(contains(r.err, "gather with: clothsim study folds --gather " + plan.string())) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out")) << "nothing is gathered while the array runs";
 }
 
 TEST_F(StudySweepCli, StabilityTasksAreGatheredAndTheMissingCasesNamed) {
