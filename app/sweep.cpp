@@ -584,6 +584,11 @@ extern "C" void note_interrupt(int) { g_interrupted = 1; }
 // and not waited for, 3 when the wait was interrupted (SIGINT, SIGTERM: the array goes on), 1 on
 // an error (message printed).
 int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const SweepCommand& c, const std::string& resume) {
+  if (plan.dir.string().find_first_of(" \t\n'\"%") != std::string::npos) {
+    std::cerr << "clothsim: error: --executor slurm: the plan's folder " << plan.dir.string()
+              << " has blanks, quotes or %, which an #SBATCH --output line cannot hold; plan into another folder\n";
+    return 1;
+  }
   const std::string script = slurm_array_script(plan, pending, c);
   const fs::path script_file = plan.dir / "slurm_array.sh";
   write_atomically(script_file, script);

@@ -104,6 +104,10 @@ const std::map<std::string, Form>& forms() {
       {"scripts/test.sh", {{"test -x {src}/scripts/test.sh", "bash -n {src}/scripts/test.sh"}, "", ""}},
       // Rewrites the repository's goldens: only its syntax is checked (`clothsim golden` runs below).
       {"scripts/update_goldens.sh", {{"test -x {src}/scripts/update_goldens.sh", "bash -n {src}/scripts/update_goldens.sh"}, "", ""}},
+      // Install and start Slurm as root, run studies through it (.ci/run): only their syntax is checked.
+      {"scripts/slurm_local.sh start\\|stop",
+       {{"test -x {src}/scripts/slurm_local.sh", "bash -n {src}/scripts/slurm_local.sh"}, "", ""}},
+      {"scripts/slurm_check.sh", {{"test -x {src}/scripts/slurm_check.sh", "bash -n {src}/scripts/slurm_check.sh"}, "", ""}},
       // Benchmarks: listed, not run (the test build does not make them; scripts/test.sh does).
       {"build/release/bench/plate_bench", {{"{build}/bench/plate_bench --benchmark_list_tests"}, "", "{build}/bench/plate_bench"}},
       {"build/release/bench/refine_bench", {{"{build}/bench/refine_bench --benchmark_list_tests"}, "", "{build}/bench/refine_bench"}},
