@@ -3,6 +3,9 @@
 // scripts/plot_<name>.py with Debian's python3-matplotlib) and prints where it wrote.
 // The folder is published atomically: it is built under a temporary name and renamed at the end,
 // so a failed or interrupted study leaves an older report untouched.
+// The fold study and the stability matrix can also run as a sweep of tasks (app/sweep.hpp,
+// docs/cluster.md): planned into a folder, each case run by `clothsim task`, locally in parallel or
+// as a Slurm job array, and gathered into the same report.
 #pragma once
 
 #include "app/sweep.hpp"
