@@ -264,6 +264,16 @@ TEST_F(StudySweepCli, BadFoldersAndOptionsAreErrors) {
   EXPECT_EQ(mixed.exit_code, 1);
   EXPECT_TRUE(contains(mixed.err, "--gather uses the plan in its folder")) << mixed.err;
 
+  // -j 2 without GNU parallel: named, with the way to run the plan without it.
+  const CliResult no_parallel = run_env("PATH=/nonexistent ", std::string(kPlan) + " -j 2 --plan " + q(dir_ / "np"));
+  EXPECT_EQ(no_parallel.exit_code, 1);
+  EXPECT_TRUE(contains(no_parallel.err, "GNU parallel is not on the PATH")) << no_parallel.err;
+  EXPECT_TRUE(fs::exists(dir_ / "np" / "tasks.tsv"));
+  // A plan of the fold study is not gathered as another study.
+  const CliResult wrong = run("study stability --gather " + q(dir_ / "np"));
+  EXPECT_EQ(wrong.exit_code, 1);
+  EXPECT_TRUE(contains(wrong.err, "holds a plan of study folds, not stability")) << wrong.err;
+
   const CliResult task = run("task " + q(dir_) + " twist-loop_kl-13x9-seed1");
   EXPECT_EQ(task.exit_code, 1);
   EXPECT_TRUE(contains(task.err, "plan.json")) << task.err;
