@@ -199,25 +199,28 @@ int study_command(int argc, char** argv) {
   std::string plan_dir, gather_dir;
   std::vector<CLI::Option*> sweep_options = {
       app.add_option("--plan", plan_dir,
-                     "folds, stability: write the runs as tasks to DIR (plan.json, tasks.tsv); alone, only plan (run each with\n"
-                     "`clothsim task DIR ID`); with --executor or -j, run them there and gather")
+                     "folds, stability: write the runs as tasks to DIR (plan.json, tasks.tsv);\n"
+                     "alone, only plan (run each with `clothsim task DIR ID`); with --executor\n"
+                     "or -j, run them there and gather")
           ->type_name("DIR"),
       app.add_option("--gather", gather_dir,
-                     "folds, stability: build the report from the tasks in DIR that finished (into the plan's --out unless\n"
-                     "--out is given), naming the missing and failed ones")
+                     "folds, stability: build the report from the tasks in DIR that finished\n"
+                     "(into the plan's --out unless --out is given), naming the missing and\n"
+                     "failed ones")
           ->type_name("DIR"),
       app.add_option("--executor", sweep.executor,
-                     "folds, stability: run the tasks here (local, the default) or as a Slurm job array (slurm)")
+                     "folds, stability: run the tasks here (local, the default) or as a Slurm\n"
+                     "job array (slurm)")
           ->check(CLI::IsMember({"local", "slurm"}))
           ->type_name("local|slurm"),
       app.add_option("-j,--jobs", sweep.jobs,
-                     "folds, stability: tasks at once (local: processes, default 1, N > 1 with GNU parallel; slurm: the\n"
-                     "array throttle %N, default 32)")
+                     "folds, stability: tasks at once (local: default 1, N > 1 as processes\n"
+                     "through GNU parallel; slurm: the array throttle %N, default 32)")
           ->check(CLI::Range(1, 100000))
           ->type_name("N"),
       app.add_flag("--retry-failed", sweep.retry_failed,
-                   "folds, stability: run only the tasks of the plan in --plan DIR (default OUT/study_NAME.tasks) that have\n"
-                   "no result, then gather"),
+                   "folds, stability: run only the tasks of the plan in --plan DIR (default\n"
+                   "OUT/study_NAME.tasks) that have no result, then gather"),
       app.add_flag("--dry-run", sweep.dry_run, "slurm: plan and print the job-array script without submitting"),
       app.add_flag("--no-wait", sweep.no_wait, "slurm: submit and return (gather later with --gather DIR)"),
       app.add_option("--slurm-time", sweep.slurm_time, "slurm: time limit per task")
@@ -227,7 +230,8 @@ int study_command(int argc, char** argv) {
       app.add_option("--partition", sweep.partition, "slurm: the partition (sbatch --partition)")->type_name("NAME"),
       app.add_option("--account", sweep.account, "slurm: the account charged (sbatch --account)")->type_name("NAME"),
       app.add_option("--sbatch-arg", sweep.sbatch_args,
-                     "slurm: a further sbatch option for the script, e.g. --sbatch-arg=--qos=short (repeatable)")
+                     "slurm: a further sbatch option for the script, e.g.\n"
+                     "--sbatch-arg=--qos=short (repeatable)")
           ->type_name("OPTION")
           ->allow_extra_args(false)};
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
