@@ -213,20 +213,24 @@ std::optional<Json> completed_summary(const fs::path& dir) {
   return std::nullopt;
 }
 
-void execute(PreparedRun& run, const fs::path& root, const FiguresOptions& options) {
+// Runs `run` into root/runs/ unless a completed run of the same scene and options is there (or
+// --rerun). With `reuse_only` (the gather of a sweep) it only takes a completed run, and throws
+// when there is none.
+void execute(PreparedRun& run, const fs::path& root, const FiguresOptions& options, bool reuse_only = false) {
   const fs::path scene_file = root / "scenes" / (run.spec.id + ".json");
   const fs::path stamp_file = root / "runs" / (run.spec.id + ".stamp");
   const fs::path dir = root / "runs" / run.spec.id;
   const std::string stamp = stamp_of(run, options);
   std::error_code ec;
-  if (!options.rerun && fs::exists(stamp_file, ec) && read_text_file(stamp_file) == stamp) {
+  if ((!options.rerun || reuse_only) && fs::exists(stamp_file, ec) && read_text_file(stamp_file) == stamp) {
     if (const auto summary = completed_summary(dir)) {
       run.reused = true;
       run.wall_seconds = summary->value("wall_seconds", 0.0);
-      std::cerr << "clothsim: figures: run " << run.spec.id << ": reusing " << dir.string() << '\n';
+      if (!reuse_only) std::cerr << "clothsim: figures: run " << run.spec.id << ": reusing " << dir.string() << '\n';
       return;
     }
   }
+  if (reuse_only) throw std::runtime_error("figure run " + run.spec.id + ": no completed run in " + dir.string());
   write_atomically(scene_file, run.scene_text);
   fs::remove(stamp_file, ec);
   RunOptions run_options;
@@ -361,62 +365,158 @@ const std::vector<int>& figure_numbers() {
   return numbers;
 }
 
-int run_figures(const FiguresOptions& options) {
-  try {
-    const auto start = std::chrono::steady_clock::now();
-    const std::vector<FigureSpec> all = figure_specs();
-    std::vector<FigureSpec> wanted;
-    for (const FigureSpec& f : all)
-      if (options.figures.empty() ||
-          std::find(options.figures.begin(), options.figures.end(), f.number) != options.figures.end())
-        wanted.push_back(f);
-    for (int n : options.figures)
-      if (std::find(figure_numbers().begin(), figure_numbers().end(), n) == figure_numbers().end())
-        throw std::invalid_argument("no figure " + std::to_string(n) + " (allowed: 1 7 8 9 10 11)");
+namespace {
 
-    // The runs the figures need, each to the latest time one of its panels shows.
-    std::map<std::string, double> needed;
-    for (const FigureSpec& f : wanted)
-      for (const PanelSpec& p : f.panels) needed[p.run] = std::max(needed[p.run], p.time);
-    const fs::path scenes_dir = resource_dir("scenes");
-    std::map<std::string, PreparedRun> runs;
-    for (const RunSpec& spec : run_specs())
-      if (needed.count(spec.id)) runs.emplace(spec.id, prepare(spec, scenes_dir, needed[spec.id]));
+// The requested figures (all when none is named); throws for an unknown number.
+std::vector<FigureSpec> wanted_figures(const FiguresOptions& options) {
+  for (int n : options.figures)
+    if (std::find(figure_numbers().begin(), figure_numbers().end(), n) == figure_numbers().end())
+      throw std::invalid_argument("no figure " + std::to_string(n) + " (allowed: 1 7 8 9 10 11)");
+  std::vector<FigureSpec> wanted;
+  for (const FigureSpec& f : figure_specs())
+    if (options.figures.empty() ||
+        std::find(options.figures.begin(), options.figures.end(), f.number) != options.figures.end())
+      wanted.push_back(f);
+  return wanted;
+}
 
-    const fs::path root = options.out_root / "figures";
+// The runs the figures need, each to the latest time one of its panels shows, in run_specs() order.
+std::vector<PreparedRun> prepared_runs(const std::vector<FigureSpec>& wanted) {
+  std::map<std::string, double> needed;
+  for (const FigureSpec& f : wanted)
+    for (const PanelSpec& p : f.panels) needed[p.run] = std::max(needed[p.run], p.time);
+  const fs::path scenes_dir = resource_dir("scenes");
+  std::vector<PreparedRun> runs;
+  for (const RunSpec& spec : run_specs())
+    if (needed.count(spec.id)) runs.push_back(prepare(spec, scenes_dir, needed[spec.id]));
+  return runs;
+}
+
+// Draws the figures whose runs are all in `runs` (the others are named in `skipped`) and writes
+// figures.md (every figN.md present of a figure not skipped, in order).
+void draw_figures(const std::vector<FigureSpec>& wanted, const std::map<std::string, PreparedRun>& runs,
+                  const fs::path& root, const FiguresOptions& options, double seconds, std::vector<std::string>& skipped) {
+  std::set<int> left_out;
+  for (const FigureSpec& figure : wanted) {
+    std::vector<PanelResult> panels;
+    std::vector<const PreparedRun*> panel_runs;
+    std::string missing;
+    for (const PanelSpec& p : figure.panels)
+      if (!runs.count(p.run) && missing.find(p.run) == std::string::npos) missing += (missing.empty() ? "" : ", ") + p.run;
+    if (!missing.empty()) {
+      skipped.push_back("Fig. " + std::to_string(figure.number) + " (runs " + missing + ")");
+      left_out.insert(figure.number);
+      continue;
+    }
+    for (const PanelSpec& p : figure.panels) {
+      const PreparedRun& run = runs.at(p.run);
+      panels.push_back(make_panel(run, p, root, options.quick));
+      panel_runs.push_back(&run);
+    }
+    const fs::path png = root / ("fig" + std::to_string(figure.number) + ".png");
+    montage(figure, panels, png);
+    write_atomically(root / ("fig" + std::to_string(figure.number) + ".md"),
+                     figure_markdown(figure, panels, panel_runs, options));
+    std::cout << "figures: wrote " << png.string() << '\n';
+  }
+  // figures.md: every figN.md present, in order.
+  std::string index =
+      "# Figures of Thomaszewski, Wacker & Straßer (SCA 2006), reproduced by `clothsim figures`\n\n"
+      "Each section says which shipped scene and settings made each panel and what was measured on it "
+      "(docs/figures.md explains the set-ups).\n\n";
+  for (int n : figure_numbers()) {
+    const fs::path md = root / ("fig" + std::to_string(n) + ".md");
+    std::error_code ec;
+    if (!left_out.count(n) && fs::exists(md, ec)) index += read_text_file(md) + "\n";
+  }
+  if (!skipped.empty()) {
+    index += "## Not drawn\n\nSome runs of this sweep did not finish (`clothsim figures --plan DIR --retry-failed` "
+             "runs them):\n\n";
+    for (const std::string& f : skipped) index += "- " + f + "\n";
+  }
+  write_atomically(root / "figures.md", index);
+  std::cout << "figures: " << wanted.size() - skipped.size() << " figure(s) in " << fixed(seconds, 1) << " s; wrote "
+            << (root / "figures.md").string() << '\n';
+}
+
+FiguresOptions options_of(const Json& settings) {
+  FiguresOptions options;
+  options.figures = settings.at("figures").get<std::vector<int>>();
+  options.out_root = settings.at("out").get<std::string>();
+  options.width = settings.at("width").get<int>();
+  options.height = settings.at("height").get<int>();
+  options.quick = settings.at("quick").get<bool>();
+  options.rerun = settings.at("rerun").get<bool>();
+  return options;
+}
+
+// One task: the figure run `id`, into out/figures/runs/<id>/ (or a completed one reused).
+std::string run_figure_task(const nlohmann::json& settings, const std::string& id, const LogFn&) {
+  const FiguresOptions options = options_of(Json(settings));
+  const fs::path root = options.out_root / "figures";
+  for (PreparedRun& run : prepared_runs(wanted_figures(options))) {
+    if (run.spec.id != id) continue;
     fs::create_directories(root / "scenes");
     fs::create_directories(root / "runs");
-    for (auto& [id, run] : runs) execute(run, root, options);
+    execute(run, root, options);
+    return Json{{"run", id}, {"reused", run.reused}, {"wall_seconds", run.wall_seconds}}.dump(2) + "\n";
+  }
+  throw std::invalid_argument("the figures' plan has no run \"" + id + "\"");
+}
 
-    for (const FigureSpec& figure : wanted) {
-      std::vector<PanelResult> panels;
-      std::vector<const PreparedRun*> panel_runs;
-      for (const PanelSpec& p : figure.panels) {
-        const PreparedRun& run = runs.at(p.run);
-        panels.push_back(make_panel(run, p, root, options.quick));
-        panel_runs.push_back(&run);
-      }
-      const fs::path png = root / ("fig" + std::to_string(figure.number) + ".png");
-      montage(figure, panels, png);
-      write_atomically(root / ("fig" + std::to_string(figure.number) + ".md"),
-                  figure_markdown(figure, panels, panel_runs, options));
-      std::cout << "figures: wrote " << png.string() << '\n';
+int gather_figures(const nlohmann::json& settings, const GatherInput& input) {
+  const FiguresOptions options = options_of(Json(settings));
+  const fs::path root = options.out_root / "figures";
+  const std::vector<FigureSpec> wanted = wanted_figures(options);
+  std::map<std::string, PreparedRun> runs;
+  double task_seconds = 0.0;
+  for (PreparedRun& run : prepared_runs(wanted)) {
+    const auto found = input.results.find(run.spec.id);
+    if (found == input.results.end()) continue;
+    execute(run, root, options, true);
+    run.reused = Json::parse(found->second).at("reused").get<bool>();  // as the task found it
+    task_seconds += run.wall_seconds;
+    runs.emplace(run.spec.id, run);
+  }
+  std::vector<std::string> skipped;
+  draw_figures(wanted, runs, root, options, input.seconds.value_or(task_seconds), skipped);
+  for (const std::string& f : skipped) std::cerr << "clothsim: figures: not drawn: " << f << '\n';
+  return 0;
+}
+
+}  // namespace
+
+SweepStudy figures_sweep(const FiguresOptions& options) {
+  SweepStudy study;
+  study.name = "figures";
+  std::vector<int> numbers;
+  for (const FigureSpec& f : wanted_figures(options)) numbers.push_back(f.number);
+  study.settings = nlohmann::json{{"figures", numbers},
+                                  {"out", fs::absolute(options.out_root).lexically_normal().string()},
+                                  {"width", options.width},
+                                  {"height", options.height},
+                                  {"quick", options.quick},
+                                  {"rerun", options.rerun}};
+  for (const PreparedRun& run : prepared_runs(wanted_figures(options))) study.ids.push_back(run.spec.id);
+  return study;
+}
+
+const SweepHooks& figures_sweep_hooks() {
+  static const SweepHooks hooks{"result.json", run_figure_task, gather_figures};
+  return hooks;
+}
+
+int run_figures(const FiguresOptions& options, SweepCommand sweep) {
+  try {
+    sweep.out_root = options.out_root;
+    sweep.plot = true;
+    if ((sweep.gather || sweep.retry_failed) && (options.quick || options.rerun || !options.figures.empty())) {
+      std::cerr << "clothsim: error: figures: " << (sweep.gather ? "--gather" : "--retry-failed")
+                << " uses the plan in its folder; figure numbers, --quick and --rerun cannot be given with it\n";
+      return 1;
     }
-    // figures.md: every figN.md present, in order.
-    std::string index =
-        "# Figures of Thomaszewski, Wacker & Straßer (SCA 2006), reproduced by `clothsim figures`\n\n"
-        "Each section says which shipped scene and settings made each panel and what was measured on it "
-        "(docs/figures.md explains the set-ups).\n\n";
-    for (int n : figure_numbers()) {
-      const fs::path md = root / ("fig" + std::to_string(n) + ".md");
-      std::error_code ec;
-      if (fs::exists(md, ec)) index += read_text_file(md) + "\n";
-    }
-    write_atomically(root / "figures.md", index);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::cout << "figures: " << wanted.size() << " figure(s) in " << fixed(seconds, 1) << " s; wrote "
-              << (root / "figures.md").string() << '\n';
-    return 0;
+    if (!sweep.gather && !sweep.retry_failed) wanted_figures(options);  // an unknown figure before anything runs
+    return run_study_command("figures", [&] { return figures_sweep(options); }, sweep);
   } catch (const std::exception& e) {
     std::cerr << "clothsim: error: figures: " << e.what() << '\n';
     return 1;

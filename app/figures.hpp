@@ -12,7 +12,12 @@
 //   5. writes DIR/figures/figN.md (which scene and settings made each panel, what was measured) and
 //      DIR/figures/figures.md (all figN.md present, in order).
 // Every file is written under a temporary name and renamed into place, so it is whole or absent.
+// With --plan, --executor, -j or --retry-failed the runs are tasks of app/sweep.hpp (id: the run's
+// name; docs/cluster.md): run by `clothsim task` into DIR/figures/runs/ as above, then gathered
+// (steps 3–5 on the completed runs; a figure whose runs did not all finish is named, not drawn).
 #pragma once
+
+#include "app/sweep.hpp"
 
 #include <filesystem>
 #include <string>
@@ -32,6 +37,11 @@ struct FiguresOptions {
 const std::vector<int>& figure_numbers();
 
 // Returns the process exit code (0: every requested figure written; 1: an error, named on stderr).
-int run_figures(const FiguresOptions& options);
+int run_figures(const FiguresOptions& options, SweepCommand sweep = {});
+
+// The figures as a sweep (settings: the figure numbers, output root, panel size, quick, rerun) and
+// their task and gather, for app/sweep.cpp.
+SweepStudy figures_sweep(const FiguresOptions& options);
+const SweepHooks& figures_sweep_hooks();
 
 }  // namespace clothsim

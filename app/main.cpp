@@ -161,6 +161,60 @@ int golden_command(int argc, char** argv) {
   return clothsim::golden_check(manifest, options);
 }
 
+// The options that run a study's cases as tasks (app/sweep.hpp, docs/cluster.md): --plan,
+// --gather, --executor, -j, --retry-failed and the Slurm options.
+std::vector<CLI::Option*> add_sweep_options(CLI::App& app, clothsim::SweepCommand& sweep, std::string& plan_dir,
+                                            std::string& gather_dir) {
+  return {
+      app.add_option("--plan", plan_dir,
+                     "write the runs as tasks to DIR (plan.json, tasks.tsv);\n"
+                     "alone, only plan (run each with `clothsim task DIR ID`); with --executor\n"
+                     "or -j, run them there and gather")
+          ->type_name("DIR"),
+      app.add_option("--gather", gather_dir,
+                     "build the report from the tasks in DIR that finished\n"
+                     "(into the plan's --out unless --out is given), naming the missing and\n"
+                     "failed ones")
+          ->type_name("DIR"),
+      app.add_option("--executor", sweep.executor,
+                     "run the tasks here (local, the default) or as a Slurm\n"
+                     "job array (slurm)")
+          ->check(CLI::IsMember({"local", "slurm"}))
+          ->type_name("local|slurm"),
+      app.add_option("-j,--jobs", sweep.jobs,
+                     "tasks at once (local: default 1, N > 1 as processes\n"
+                     "through GNU parallel; slurm: the array throttle %N, default 32)")
+          ->check(CLI::Range(1, 100000))
+          ->type_name("N"),
+      app.add_flag("--retry-failed", sweep.retry_failed,
+                   "run only the tasks of the plan in --plan DIR (default\n"
+                   "OUT/study_NAME.tasks, OUT/figures.tasks) that have no result, then gather"),
+      app.add_flag("--dry-run", sweep.dry_run, "slurm: plan and print the job-array script without submitting"),
+      app.add_flag("--no-wait", sweep.no_wait, "slurm: submit and return (gather later with --gather DIR)"),
+      app.add_option("--slurm-time", sweep.slurm_time, "slurm: time limit per task")
+          ->type_name("[D-]HH:MM:SS")
+          ->capture_default_str(),
+      app.add_option("--slurm-mem", sweep.slurm_mem, "slurm: memory per task")->type_name("SIZE")->capture_default_str(),
+      app.add_option("--partition", sweep.partition, "slurm: the partition (sbatch --partition)")->type_name("NAME"),
+      app.add_option("--account", sweep.account, "slurm: the account charged (sbatch --account)")->type_name("NAME"),
+      app.add_option("--sbatch-arg", sweep.sbatch_args,
+                     "slurm: a further sbatch option for the script, e.g.\n"
+                     "--sbatch-arg=--qos=short (repeatable)")
+          ->type_name("OPTION")
+          ->allow_extra_args(false)};
+}
+
+// Completes `sweep` after parsing: the folders given, whether --out was, this binary.
+void finish_sweep_options(CLI::App& app, char** argv, clothsim::SweepCommand& sweep, const std::string& plan_dir,
+                          const std::string& gather_dir) {
+  if (!plan_dir.empty()) sweep.plan = plan_dir;
+  if (!gather_dir.empty()) sweep.gather = gather_dir;
+  sweep.out_given = app.get_option("--out")->count() > 0;
+  std::error_code ec;
+  sweep.clothsim = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec) sweep.clothsim = argv[0];
+}
+
 // `clothsim study convergence|stability|folds [--out DIR] [--quick] [--no-plot]`, and for `folds`
 // the options that rerun it differently (--meshes, --seeds, --methods, --cases, --preset,
 // --amplitude, --dt, --end).
@@ -194,46 +248,10 @@ int study_command(int argc, char** argv) {
       app.add_option("--amplitude", amplitude, "folds: imperfection amplitude [m] (default 0.5 t_eff)")->type_name("M"),
       app.add_option("--dt", dt, "folds: time step [s] (default 0.005)")->type_name("S"),
       app.add_option("--end", end, "folds: simulated time [s] (default 1, the end of the motion)")->type_name("S")};
-  // Plan / task / gather and the executors (app/sweep.hpp, docs/cluster.md): `study folds` only.
+  // Plan / task / gather and the executors: `study folds` and `study stability`.
   clothsim::SweepCommand sweep;
   std::string plan_dir, gather_dir;
-  std::vector<CLI::Option*> sweep_options = {
-      app.add_option("--plan", plan_dir,
-                     "folds, stability: write the runs as tasks to DIR (plan.json, tasks.tsv);\n"
-                     "alone, only plan (run each with `clothsim task DIR ID`); with --executor\n"
-                     "or -j, run them there and gather")
-          ->type_name("DIR"),
-      app.add_option("--gather", gather_dir,
-                     "folds, stability: build the report from the tasks in DIR that finished\n"
-                     "(into the plan's --out unless --out is given), naming the missing and\n"
-                     "failed ones")
-          ->type_name("DIR"),
-      app.add_option("--executor", sweep.executor,
-                     "folds, stability: run the tasks here (local, the default) or as a Slurm\n"
-                     "job array (slurm)")
-          ->check(CLI::IsMember({"local", "slurm"}))
-          ->type_name("local|slurm"),
-      app.add_option("-j,--jobs", sweep.jobs,
-                     "folds, stability: tasks at once (local: default 1, N > 1 as processes\n"
-                     "through GNU parallel; slurm: the array throttle %N, default 32)")
-          ->check(CLI::Range(1, 100000))
-          ->type_name("N"),
-      app.add_flag("--retry-failed", sweep.retry_failed,
-                   "folds, stability: run only the tasks of the plan in --plan DIR (default\n"
-                   "OUT/study_NAME.tasks) that have no result, then gather"),
-      app.add_flag("--dry-run", sweep.dry_run, "slurm: plan and print the job-array script without submitting"),
-      app.add_flag("--no-wait", sweep.no_wait, "slurm: submit and return (gather later with --gather DIR)"),
-      app.add_option("--slurm-time", sweep.slurm_time, "slurm: time limit per task")
-          ->type_name("[D-]HH:MM:SS")
-          ->capture_default_str(),
-      app.add_option("--slurm-mem", sweep.slurm_mem, "slurm: memory per task")->type_name("SIZE")->capture_default_str(),
-      app.add_option("--partition", sweep.partition, "slurm: the partition (sbatch --partition)")->type_name("NAME"),
-      app.add_option("--account", sweep.account, "slurm: the account charged (sbatch --account)")->type_name("NAME"),
-      app.add_option("--sbatch-arg", sweep.sbatch_args,
-                     "slurm: a further sbatch option for the script, e.g.\n"
-                     "--sbatch-arg=--qos=short (repeatable)")
-          ->type_name("OPTION")
-          ->allow_extra_args(false)};
+  const std::vector<CLI::Option*> sweep_options = add_sweep_options(app, sweep, plan_dir, gather_dir);
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
   options.out_root = out;
   options.plot = !no_plot;
@@ -245,14 +263,7 @@ int study_command(int argc, char** argv) {
                      "one process)\n";
         return 1;
       }
-  if (!plan_dir.empty()) sweep.plan = plan_dir;
-  if (!gather_dir.empty()) sweep.gather = gather_dir;
-  sweep.out_given = app.get_option("--out")->count() > 0;
-  {
-    std::error_code ec;
-    sweep.clothsim = std::filesystem::read_symlink("/proc/self/exe", ec);
-    if (ec) sweep.clothsim = argv[0];
-  }
+  finish_sweep_options(app, argv, sweep, plan_dir, gather_dir);
   if (which != "folds")
     for (const CLI::Option* o : fold_options)
       if (o->count() > 0) {
@@ -297,7 +308,11 @@ int figures_command(int argc, char** argv) {
   app.add_option("--size", size, "Panel size, default 480x360")->type_name("WxH");
   app.add_flag("--quick", options.quick, "Runs of 2 frames only (seconds; the panels do not show the figure)");
   app.add_flag("--rerun", options.rerun, "Run every scene again, even if a completed run of it exists");
+  clothsim::SweepCommand sweep;
+  std::string plan_dir, gather_dir;
+  add_sweep_options(app, sweep, plan_dir, gather_dir);
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
+  finish_sweep_options(app, argv, sweep, plan_dir, gather_dir);
   options.out_root = out;
   if (!size.empty()) {
     int width = 0, height = 0, used = 0;
@@ -315,7 +330,7 @@ int figures_command(int argc, char** argv) {
       std::cerr << "clothsim: error: figures: no figure " << n << " (allowed: 1 7 8 9 10 11)\n";
       return 1;
     }
-  return clothsim::run_figures(options);
+  return clothsim::run_figures(options, sweep);
 }
 
 }  // namespace

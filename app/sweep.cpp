@@ -1,6 +1,7 @@
 #include "app/sweep.hpp"
 
 #include "app/command_output.hpp"
+#include "app/figures.hpp"
 #include "app/output_folders.hpp"
 #include "app/study.hpp"
 #include "sim/study/report_format.hpp"
@@ -196,8 +197,11 @@ std::string overhead_line(const fs::path& dir, const std::vector<std::string>& i
          format_fixed(delay / static_cast<double>(tasks.size()), 2) + " s of dispatch overhead per task";
 }
 
+// The command of study `name`: "clothsim study folds", "clothsim figures".
+std::string command_of(const std::string& name) { return name == "figures" ? "clothsim figures" : "clothsim study " + name; }
+
 std::string resume_command(const std::string& name, const fs::path& dir, const SweepCommand& c) {
-  std::string command = "clothsim study " + name + " --plan " + shell_word(dir.string()) + " --retry-failed";
+  std::string command = command_of(name) + " --plan " + shell_word(dir.string()) + " --retry-failed";
   const std::string executor = c.executor.empty() ? (c.jobs > 1 ? "local" : "") : c.executor;
   if (!executor.empty()) command += " --executor " + executor;
   if (c.jobs > 0) command += " -j " + std::to_string(c.jobs);
@@ -221,7 +225,8 @@ void log_line(const std::string& line) { std::cerr << "clothsim: " << line << st
 const SweepHooks& sweep_hooks(const std::string& name) {
   if (name == "folds") return fold_sweep_hooks();
   if (name == "stability") return stability_sweep_hooks();
-  throw std::invalid_argument("study \"" + name + "\" cannot be run as tasks (only folds and stability can)");
+  if (name == "figures") return figures_sweep_hooks();
+  throw std::invalid_argument("\"" + name + "\" cannot be run as tasks (folds, stability and figures can)");
 }
 
 std::filesystem::path find_on_path(const std::string& name) {
@@ -434,7 +439,7 @@ int gather_sweep(const fs::path& dir, const std::optional<fs::path>& out_root, b
               << ":\n";
     for (const std::string& p : input.problems) std::cerr << "  " << p << '\n';
     std::cerr << "Run them with: "
-              << (resume.empty() ? "clothsim study " + plan.study + " --plan " + shell_word(plan.dir.string()) +
+              << (resume.empty() ? command_of(plan.study) + " --plan " + shell_word(plan.dir.string()) +
                                        " --retry-failed [--executor ...]"
                                  : resume)
               << '\n';
@@ -485,10 +490,10 @@ std::string slurm_array_script(const SweepPlan& plan, const std::vector<int>& in
   const std::string tasks = shell_word((plan.dir / "tasks.tsv").string());
   std::ostringstream s;
   s << "#!/bin/bash\n"
-    << "# clothsim study " << plan.study << " as a Slurm job array: array task I runs line I of tasks.tsv\n"
+    << "# " << command_of(plan.study) << " as a Slurm job array: array task I runs line I of tasks.tsv\n"
     << "# (`clothsim task DIR ID`, whose result goes to DIR/runs/ID/). Written by clothsim; submit it again\n"
     << "# with `sbatch " << (plan.dir / "slurm_array.sh").string() << "`, gather with\n"
-    << "# `clothsim study " << plan.study << " --gather " << plan.dir.string() << "` (docs/cluster.md).\n"
+    << "# `" << command_of(plan.study) << " --gather " << plan.dir.string() << "` (docs/cluster.md).\n"
     << "#SBATCH --job-name=clothsim-" << plan.study << '\n'
     << "#SBATCH --array=" << array_ranges(indices) << '%' << throttle << '\n'
     << "#SBATCH --ntasks=1\n"
@@ -597,8 +602,8 @@ int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const Swee
   if (c.dry_run) {
     std::cout << script;
     std::cerr << "clothsim: dry run: the job-array script above is " << script_file.string()
-              << " (not submitted); submit it with `sbatch " << script_file.string() << "` and gather with `clothsim study "
-              << plan.study << " --gather " << shell_word(plan.dir.string()) << "`\n";
+              << " (not submitted); submit it with `sbatch " << script_file.string() << "` and gather with `"
+              << command_of(plan.study) << " --gather " << shell_word(plan.dir.string()) << "`\n";
     return 2;
   }
   const fs::path sbatch = find_on_path("sbatch");
@@ -665,7 +670,7 @@ int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const Swee
   poll();  // the job id, if sbatch returned before the first poll
   const double wall = epoch_seconds() - start;
   if (g_interrupted) {
-    const std::string gather = "clothsim study " + plan.study + " --gather " + shell_word(plan.dir.string()) +
+    const std::string gather = command_of(plan.study) + " --gather " + shell_word(plan.dir.string()) +
                                (c.out_given ? " --out " + shell_word(c.out_root.string()) : "") +
                                (c.plot ? "" : " --no-plot");
     if (job.empty())
@@ -696,7 +701,7 @@ int run_slurm(const SweepPlan& plan, const std::vector<int>& pending, const Swee
   }
   if (c.no_wait) {
     std::cout << "slurm: submitted job array " << job << " (" << pending.size() << " tasks of " << plan.ids.size()
-              << "); when it has ended (squeue -j " << job << "), gather with: clothsim study " << plan.study
+              << "); when it has ended (squeue -j " << job << "), gather with: " << command_of(plan.study)
               << " --gather " << shell_word(plan.dir.string()) << (c.out_given ? " --out " + shell_word(c.out_root.string()) : "")
               << (c.plot ? "" : " --no-plot") << '\n';
     return 2;
@@ -754,7 +759,8 @@ int run_study_command(const std::string& name, const std::function<SweepStudy()>
   }
 
   // A plan in a folder.
-  const fs::path dir = absolute_path(c.plan.value_or(c.out_root / ("study_" + name + ".tasks")));
+  const fs::path dir =
+      absolute_path(c.plan.value_or(c.out_root / ((name == "figures" ? name : "study_" + name) + ".tasks")));
   SweepPlan plan;
   try {
     std::error_code ec;
@@ -778,7 +784,7 @@ int run_study_command(const std::string& name, const std::function<SweepStudy()>
       if (c.plan && c.executor.empty() && c.jobs == 0) {
         std::cout << "planned " << plan.ids.size() << " tasks of study " << name << " in " << dir.string()
                   << " (tasks.tsv); run each with `clothsim task " << shell_word(dir.string())
-                  << " ID`, then gather with `clothsim study " << name << " --gather " << shell_word(dir.string())
+                  << " ID`, then gather with `" << command_of(name) << " --gather " << shell_word(dir.string())
                   << "`\n";
         return 0;
       }

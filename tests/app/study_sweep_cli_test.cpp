@@ -4,7 +4,8 @@
 // in every column but the times; --executor slurm without sbatch on the PATH, with a submission
 // sbatch rejects, and as a dry run; a stand-in sbatch that runs the array here but leaves one
 // task out, the gather naming it and the printed --retry-failed command finishing the study; an
-// interrupted wait (the array goes on; the gather command printed); bad
+// interrupted wait (the array goes on; the gather command printed); `clothsim figures` as tasks
+// (a figure with missing runs named, not drawn; then the one-process run's figure); bad
 // plan folders and sweep options on the convergence study are errors; the stability matrix
 // planned, two cases run by hand and gathered, the others named.
 #include "tests/support/cli_fixture.hpp"
@@ -242,6 +243,47 @@ TEST_F(StudySweepCli, StabilityTasksAreGatheredAndTheMissingCasesNamed) {
   EXPECT_EQ(run("study stability --no-plot --gather " + q(plan)).exit_code, 1);
   EXPECT_EQ(read_file_bytes(report / "results.csv"), csv);
   EXPECT_EQ(read_file_bytes(report / "table.md"), table);
+}
+
+// fig N.md without its last column (the runs' wall times).
+std::string without_wall_times(const std::string& md) {
+  std::istringstream in(md);
+  std::string out, line;
+  while (std::getline(in, line)) {
+    if (line.rfind("| ", 0) == 0 && line.size() > 2) {
+      const size_t last = line.rfind(" | ", line.size() - 3);
+      if (last != std::string::npos) line = line.substr(0, last);
+    }
+    out += line + '\n';
+  }
+  return out;
+}
+
+TEST_F(StudySweepCli, FiguresAsTasksGiveTheSameFigureAndNameWhatIsMissing) {
+  const CliResult serial = run("figures 10 --quick --out " + q(dir_ / "serial"));
+  ASSERT_EQ(serial.exit_code, 0) << serial.err;
+  const fs::path a = dir_ / "serial" / "figures";
+  // Planned: the four runs of Fig. 10; two run by hand, the gather names the figure it cannot draw.
+  const fs::path plan = dir_ / "plan";
+  ASSERT_EQ(run("figures 10 --quick --plan " + q(plan) + " --out " + q(dir_ / "tasks")).exit_code, 0);
+  ASSERT_EQ(run("task " + q(plan) + " catenary_mesh").exit_code, 0);
+  ASSERT_EQ(run("task " + q(plan) + " catenary_black_denim").exit_code, 0);
+  const CliResult partial = run("figures --gather " + q(plan));
+  EXPECT_EQ(partial.exit_code, 1);
+  EXPECT_TRUE(contains(partial.err, "not drawn: Fig. 10 (runs catenary_gray_interlock, catenary_pink_ribbon_brown)"))
+      << partial.err;
+  EXPECT_TRUE(contains(partial.err, "Run them with: clothsim figures --plan " + plan.string() + " --retry-failed"))
+      << partial.err;
+  const fs::path b = dir_ / "tasks" / "figures";
+  EXPECT_FALSE(fs::exists(b / "fig10.png"));
+  EXPECT_TRUE(contains(read_file_bytes(b / "figures.md"), "## Not drawn"));
+  // The rest in this process, then the same figure as the one-process run (but for wall times).
+  const CliResult rest = run("figures --plan " + q(plan) + " --retry-failed -j 1");
+  ASSERT_EQ(rest.exit_code, 0) << rest.err;
+  EXPECT_TRUE(contains(rest.err, "2 of 4 tasks to run")) << rest.err;
+  EXPECT_EQ(read_file_bytes(b / "fig10.png"), read_file_bytes(a / "fig10.png"));
+  EXPECT_EQ(without_wall_times(read_file_bytes(b / "fig10.md")), without_wall_times(read_file_bytes(a / "fig10.md")));
+  EXPECT_FALSE(contains(read_file_bytes(b / "figures.md"), "## Not drawn"));
 }
 
 TEST_F(StudySweepCli, BadFoldersAndOptionsAreErrors) {
