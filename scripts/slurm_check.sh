@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # CI check of issue 31: the quick fold study and the quick stability matrix, each run serially,
 # with the local executor (-j 2) and as a Slurm job array on a one-node cluster started here
-# (scripts/slurm_local.sh, as root), give the same results.csv in every column but wall_seconds.
+# (scripts/slurm_local.sh, as root), give the same results.csv in every column but wall_seconds;
+# `clothsim figures 10 --quick` the same fig10.png and fig10.md (wall times aside).
 # Prints the wall times and Slurm's dispatch overhead per task. Needs a built build/release/clothsim (scripts/test.sh) or CLOTHSIM_BIN.
 # Usage: scripts/slurm_check.sh
 set -euo pipefail
@@ -45,6 +46,28 @@ for name in folds stability; do
   slurm=$(since "$t")
   summary+="slurm_check: quick $name study wall times: serial $serial s, local -j 2 $local_j2 s, slurm $slurm s"$'\n'
 done
+
+# clothsim figures 10 --quick (its four runs as tasks): the same fig10.png, fig10.md but for the
+# runs' wall times.
+t=$(now)
+"$bin" figures 10 --quick --out "$tmp/serial" 2>"$tmp/serial_figures.log" >/dev/null
+serial=$(since "$t")
+t=$(now)
+"$bin" figures 10 --quick -j 2 --out "$tmp/local" 2>"$tmp/local_figures.log" | grep '^local:' ||
+  { cat "$tmp/local_figures.log" >&2; exit 1; }
+local_j2=$(since "$t")
+t=$(now)
+"$bin" figures 10 --quick --executor slurm --slurm-time 10 --slurm-mem 1G --out "$tmp/slurm" 2>"$tmp/slurm_figures.log" |
+  grep '^slurm:' || { cat "$tmp/slurm_figures.log" >&2; exit 1; }
+slurm=$(since "$t")
+summary+="slurm_check: quick figure 10 wall times: serial $serial s, local -j 2 $local_j2 s, slurm $slurm s"$'\n'
+for other in local slurm; do
+  cmp "$tmp/serial/figures/fig10.png" "$tmp/$other/figures/fig10.png" ||
+    { echo "slurm_check: error: $other's fig10.png is not the serial run's" >&2; exit 1; }
+  diff <(sed 's/| [^|]* |$//' "$tmp/serial/figures/fig10.md") <(sed 's/| [^|]* |$//' "$tmp/$other/figures/fig10.md") >&2 ||
+    { echo "slurm_check: error: $other's fig10.md differs from the serial run's (wall times aside)" >&2; exit 1; }
+done
+echo "slurm_check: figures: fig10.png and fig10.md of -j 2 and of slurm equal the serial run's (wall times aside)"
 
 # results.csv without wall_seconds, compared with the serial run's.
 /usr/bin/python3 - "$tmp" <<'PY'
