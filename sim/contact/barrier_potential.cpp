@@ -416,6 +416,10 @@ void BarrierPotential::begin_step(StepPositions& step, const Eigen::VectorXd& x,
   } else {
     make_candidates(step);
   }
+  // (Either way the candidates serve the guess's end points: the first linearisation, which is
+  // usually at the guess, need not check them again.)
+  served_velocity_ = v_guess;
+  served_known_ = true;
   // Lagged friction: the pairs pressed at the start of the step, with their normal force and
   // tangent plane there (fixed over the step, so the friction potential is convex in v).
   friction_rows_.clear();
