@@ -253,8 +253,9 @@ void BarrierPotential::prepare_candidates(const StepPositions& step) {
     const double gap = box_gap(corner, is_point_triangle(c.kind));
     lower[i] = std::max(lower[i], gap);
     if (c.near || !(gap < settings_.thickness)) return;
-    if (reuse && end_known_[i]) {
-      // (The last linearisation's geometry, of this start up to round-off: its bound less that.)
+    // (The last linearisation's geometry, of this start up to round-off: its bound less that. Not
+    // where linearise signed it negative by its own start, a crossing: a fresh geometry is unsigned.)
+    if (reuse && end_known_[i] && end_geometry_[i].distance > 0) {
       cand_start_[i] = end_geometry_[i];
       cand_start_known_[i] = 1;
       lower[i] = std::max(0.0, cand_start_[i].distance - motion);
