@@ -209,6 +209,8 @@ class BarrierPotential {
   std::vector<size_t> closest_set_;
   std::vector<PairGeometry> end_geometry_;
   std::vector<char> end_known_;  // (which of end_geometry_ the last linearisation made)
+  std::vector<double> pair_k_, pair_energy_;  // linearise's per active pair: stiffness, energy
+  std::vector<Eigen::Vector3d> pair_force_;    // and the force on its row
 };
 
 }  // namespace clothsim::contact

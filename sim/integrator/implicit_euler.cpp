@@ -162,7 +162,7 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
       groups.erase(std::unique(groups.begin(), groups.end()), groups.end());
       if (!coupled_.covers(a, groups)) coupled_.rebuild(a, groups, /*keep_previous=*/true);
       coupled_.set_base(a);
-      for (const auto& [row, hw] : node_blocks) coupled_.add_block(row, hw);
+      coupled_.add_blocks(node_blocks);
       coupled_in_use_ = true;
       return coupled_.matrix();
     };

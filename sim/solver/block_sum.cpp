@@ -1,5 +1,8 @@
 #include "sim/solver/block_sum.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <functional>
 #include <stdexcept>
@@ -96,13 +99,15 @@ void BlockSum::add_product(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   if (n > 0) {
     gathered_.resize(3 * n);
     forces_.setZero(3 * n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const size_t p = static_cast<size_t>(points_[static_cast<size_t>(i)]);
-      Eigen::Vector3d u = Eigen::Vector3d::Zero();
-      for (int e = map->offsets[p]; e < map->offsets[p + 1]; ++e)
-        u += map->weights[static_cast<size_t>(e)] * x.segment<3>(3 * map->nodes[static_cast<size_t>(e)]);
-      gathered_.segment<3>(3 * i) = u;
-    }
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 512), [&](const tbb::blocked_range<Eigen::Index>& range) {
+      for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
+        const size_t p = static_cast<size_t>(points_[static_cast<size_t>(i)]);
+        Eigen::Vector3d u = Eigen::Vector3d::Zero();
+        for (int e = map->offsets[p]; e < map->offsets[p + 1]; ++e)
+          u += map->weights[static_cast<size_t>(e)] * x.segment<3>(3 * map->nodes[static_cast<size_t>(e)]);
+        gathered_.segment<3>(3 * i) = u;
+      }
+    });
   }
   for (size_t r = 0; r < merged_.size(); ++r) {
     const auto& [block, hw] = merged_[r];

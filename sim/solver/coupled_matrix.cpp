@@ -1,5 +1,8 @@
 #include "sim/solver/coupled_matrix.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -188,6 +191,58 @@ void CoupledMatrix::add_block(const NodeRow& row, const Eigen::Matrix3d& h) {
       }
     }
   }
+}
+
+void CoupledMatrix::add_blocks(const std::vector<std::pair<NodeRow, Eigen::Matrix3d>>& blocks) {
+  const bool node_form = std::all_of(blocks.begin(), blocks.end(), [](const auto& b) {
+    return b.first.dofs.empty() && std::is_sorted(b.first.nodes.begin(), b.first.nodes.end());
+  });
+  if (!node_form) {
+    for (const auto& [row, h] : blocks) add_block(row, h);
+    return;
+  }
+  // Per column node q, the (block, entry of q in it) in increasing block: a column's values then
+  // receive the blocks' terms in the order add_block, block by block, would add them.
+  const size_t num_nodes = adjacency_.size();
+  std::vector<int> start(num_nodes + 1, 0);
+  for (const auto& [row, h] : blocks)
+    for (const auto& entry : row.nodes) ++start[static_cast<size_t>(entry.first) + 1];
+  std::vector<int> columns;
+  for (size_t q = 0; q < num_nodes; ++q) {
+    if (start[q + 1] > 0) columns.push_back(static_cast<int>(q));
+    start[q + 1] += start[q];
+  }
+  std::vector<std::pair<int, int>> entries(static_cast<size_t>(start.back()));
+  {
+    std::vector<int> next(start.begin(), start.end() - 1);
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      const NodeRow& row = blocks[b].first;
+      for (size_t k = 0; k < row.nodes.size(); ++k)
+        entries[static_cast<size_t>(next[static_cast<size_t>(row.nodes[k].first)]++)] = {static_cast<int>(b), static_cast<int>(k)};
+    }
+  }
+  double* values = matrix_.valuePtr();
+  const int* outer = matrix_.outerIndexPtr();
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, columns.size(), 16), [&](const tbb::blocked_range<size_t>& range) {
+    for (size_t j = range.begin(); j != range.end(); ++j) {
+      const int q = columns[j];
+      const std::vector<int>& coupled = adjacency_[static_cast<size_t>(q)];
+      for (int e = start[static_cast<size_t>(q)]; e < start[static_cast<size_t>(q) + 1]; ++e) {
+        const auto [b, k] = entries[static_cast<size_t>(e)];
+        const NodeRow& row = blocks[static_cast<size_t>(b)].first;
+        const Eigen::Matrix3d hq = blocks[static_cast<size_t>(b)].second * row.nodes[static_cast<size_t>(k)].second;
+        auto at = coupled.begin();
+        for (const auto& [p, wp] : row.nodes) {
+          at = std::lower_bound(at, coupled.end(), p);
+          const int rank = static_cast<int>(at - coupled.begin());
+          for (int c = 0; c < 3; ++c) {
+            double* column = values + outer[3 * q + c] + 3 * rank;
+            for (int r = 0; r < 3; ++r) column[r] += wp * hq(r, c);
+          }
+        }
+      }
+    }
+  });
 }
 
 }  // namespace clothsim

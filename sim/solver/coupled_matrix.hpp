@@ -103,6 +103,9 @@ class CoupledMatrix {
   void set_base(const Eigen::SparseMatrix<double>& a);
   // Adds Bᵀ H B of `row` (H symmetric, 3 × 3); every coupling of the row must be in the pattern.
   void add_block(const NodeRow& row, const Eigen::Matrix3d& h);
+  // add_block for each of `blocks` in turn, with the same sums bit for bit; blocks in node form
+  // are added one column node per thread.
+  void add_blocks(const std::vector<std::pair<NodeRow, Eigen::Matrix3d>>& blocks);
 
   Eigen::SparseMatrix<double>& matrix() { return matrix_; }
   const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }

@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -99,6 +100,51 @@ TEST(CoupledMatrix, CoversOnlyItsCouplingsAndARebuildCanKeepThem) {
 
 // A row on points against the same row written out over the nodes: p_i = Σ_j w_ij x_j with
 // points sharing nodes (as neighbouring surface points share their stencils).
+// add_blocks gives add_block's sums, block by block, bit for bit: many overlapping node-form rows
+// (sorted, as node_row makes them; one unsorted), and the per-DOF fallback.
+TEST(CoupledMatrix, AddBlocksEqualsAddBlockOneByOneBitForBit) {
+  const int n = 40;
+  const Eigen::SparseMatrix<double> a = chain(n);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_int_distribution<int> node(0, n - 1);
+  std::vector<std::pair<NodeRow, Eigen::Matrix3d>> blocks;
+  for (int r = 0; r < 200; ++r) {
+    NodeRow row;
+    for (int k = 0; k < 12; ++k) row.nodes.emplace_back(node(rng), u(rng));
+    std::sort(row.nodes.begin(), row.nodes.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    row.nodes.erase(std::unique(row.nodes.begin(), row.nodes.end(), [](const auto& x, const auto& y) { return x.first == y.first; }),
+                    row.nodes.end());
+    if (r == 7) std::reverse(row.nodes.begin(), row.nodes.end());  // (add_block sorts a copy)
+    Eigen::Matrix3d h = Eigen::Matrix3d::NullaryExpr([&](Eigen::Index, Eigen::Index) { return u(rng); });
+    blocks.emplace_back(row, h + h.transpose());
+  }
+  std::vector<std::vector<int>> groups;
+  for (const auto& [row, h] : blocks) groups.push_back(row.node_list());
+  for (const bool with_dofs : {false, true}) {
+    std::vector<std::pair<NodeRow, Eigen::Matrix3d>> these = blocks;
+    if (with_dofs) these[3].first.dofs = {{3 * these[3].first.nodes[0].first + 1, Eigen::Vector3d(u(rng), u(rng), u(rng))}};
+    CoupledMatrix one, all;
+    one.rebuild(a, groups);
+    all.rebuild(a, groups);
+    one.set_base(a);
+    all.set_base(a);
+    for (const auto& [row, h] : these) one.add_block(row, h);
+    all.add_blocks(these);
+    ASSERT_EQ(one.matrix().nonZeros(), all.matrix().nonZeros());
+    for (Eigen::Index k = 0; k < one.matrix().nonZeros(); ++k)
+      ASSERT_EQ(one.matrix().valuePtr()[k], all.matrix().valuePtr()[k]) << "entry " << k << (with_dofs ? " (with a per-DOF row)" : "");
+    // and not merely equal to each other: A plus the blocks
+    const Eigen::MatrixXd dense = Eigen::MatrixXd(all.matrix());
+    Eigen::MatrixXd expected = Eigen::MatrixXd(a);
+    for (const auto& [row, h] : these) {
+      const Eigen::MatrixXd b = dense_row(row, 3 * n);
+      expected += b.transpose() * h * b;
+    }
+    EXPECT_LT((dense - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.cwiseAbs().maxCoeff());
+  }
+}
+
 TEST(PointRow, ActsAsItsNodeFormAndMergesSharedNodes) {
   PointMap map;
   const std::vector<std::vector<std::pair<int, double>>> stencils = {
