@@ -4,6 +4,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -121,21 +122,31 @@ double BarrierPotential::plane_stiffness(int p) { return settings_.barrier_ratio
 // contact time on sleeve_on_arm's first 0.6 s: the candidates grow faster than their rebuilds get
 // rarer.)
 
-// The largest distance of a point p_i from the segment a_i → b_i [m] (infinite for other sizes).
+// The largest distance of a point p_i from the segment a_i → b_i [m] (infinite for other sizes;
+// NaN where a point is NaN). One pass per point, in parallel: it runs several times per step, and
+// as whole-matrix expressions its temporaries cost more than its arithmetic.
 double BarrierPotential::sweep_distance(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
   if (p.rows() != a.rows() || p.rows() != b.rows()) return std::numeric_limits<double>::infinity();
-  if (p.rows() == 0) return 0.0;
-  // (Column by column, so that it vectorises: it runs several times per step.)
-  const Eigen::ArrayX3d d = (b - a).array(), q = (p - a).array();
-  const Eigen::ArrayXd dd = d.square().rowwise().sum();
-  const Eigen::ArrayXd s = (dd > 0).select(((q * d).rowwise().sum() / dd).max(0.0).min(1.0), 0.0);
-  return std::sqrt((q - d.colwise() * s).square().rowwise().sum().maxCoeff());
+  auto larger = [](double m, double d) { return std::isnan(m) ? m : (d > m || std::isnan(d)) ? d : m; };
+  return tbb::parallel_reduce(
+      tbb::blocked_range<Eigen::Index>(0, p.rows(), 2048), 0.0,
+      [&](const tbb::blocked_range<Eigen::Index>& range, double m) {
+        for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
+          const double dx = b(i, 0) - a(i, 0), dy = b(i, 1) - a(i, 1), dz = b(i, 2) - a(i, 2);
+          const double qx = p(i, 0) - a(i, 0), qy = p(i, 1) - a(i, 1), qz = p(i, 2) - a(i, 2);
+          const double dd = dx * dx + dy * dy + dz * dz;
+          const double s = dd > 0 ? std::min(std::max((qx * dx + qy * dy + qz * dz) / dd, 0.0), 1.0) : 0.0;
+          const double rx = qx - s * dx, ry = qy - s * dy, rz = qz - s * dz;
+          m = larger(m, std::sqrt(rx * rx + ry * ry + rz * rz));
+        }
+        return m;
+      },
+      larger);
 }
 
-bool BarrierPotential::serves(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d* q) const {
+bool BarrierPotential::serves(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d& q, double& sp, double& sq) const {
   const double r = serve_radius();
-  return obstacles_serve_ && sweep_distance(p, built_p0_, guess_) <= r &&
-         (q == nullptr || sweep_distance(*q, built_p0_, guess_) <= r);
+  return obstacles_serve_ && (sp = sweep_distance(p, built_p0_, guess_)) <= r && (sq = sweep_distance(q, built_p0_, guess_)) <= r;
 }
 
 // (The step bound's end of a move is the next linearisation's point, and its start the last
@@ -143,9 +154,11 @@ bool BarrierPotential::serves(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d*
 bool BarrierPotential::served(const Eigen::VectorXd& v, const Eigen::MatrixX3d& p) {
   if (!obstacles_serve_) return false;
   if (served_known_ && v.size() == served_velocity_.size() && v == served_velocity_) return true;
-  if (!(sweep_distance(p, built_p0_, guess_) <= serve_radius())) return false;
+  const double sweep = sweep_distance(p, built_p0_, guess_);
+  if (!(sweep <= serve_radius())) return false;
   served_velocity_ = v;
   served_known_ = true;
+  served_sweep_ = sweep;
   return true;
 }
 
@@ -159,6 +172,7 @@ void BarrierPotential::check_obstacles_serve(const StepPositions& step) {
 }
 
 void BarrierPotential::make_candidates(StepPositions& step) {
+  start_sweep_ = 0.0;  // (p0 starts the paths made here)
   lin_bounds_valid_ = false;
   served_known_ = false;
   ContactCounters scratch;
@@ -412,15 +426,19 @@ void BarrierPotential::begin_step(StepPositions& step, const Eigen::VectorXd& x,
   point_mass_.setConstant(step.p0.rows(), std::numeric_limits<double>::quiet_NaN());
   check_obstacles_serve(step);
   served_known_ = false;  // (a new start)
-  if (serves(step.p0, &p1_)) {
+  double start_sweep = 0.0, guess_sweep = 0.0;
+  if (serves(step.p0, p1_, start_sweep, guess_sweep)) {
     prepare_candidates(step);
   } else {
-    make_candidates(step);
+    make_candidates(step);  // (for the path from p0 through p1: both on it)
+    start_sweep = guess_sweep = 0.0;
   }
   // (Either way the candidates serve the guess's end points: the first linearisation, which is
   // usually at the guess, need not check them again.)
   served_velocity_ = v_guess;
   served_known_ = true;
+  served_sweep_ = guess_sweep;
+  start_sweep_ = start_sweep;
   // Lagged friction: the pairs pressed at the start of the step, with their normal force and
   // tangent plane there (fixed over the step, so the friction potential is convex in v).
   friction_rows_.clear();
@@ -605,11 +623,24 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
   const Eigen::MatrixX3d pa = at_linearisation ? lin_points_ : from_start ? step.p0 : points_of(from), pb = points_of(to);
   bound_to_velocity_ = to;
   bound_to_points_ = pb;
+  const Eigen::VectorXd step_move = (pb - pa).rowwise().norm();  // per point, over the move
   // Candidates for the move pa → pb: the potential's where they serve it, else a broad phase over
-  // this move.
+  // this move. (pb is served when pa's sweep bound plus the largest point move is within the
+  // serve radius: no pass over the points.)
+  bool move_served = from_start && start_sweep_ >= 0.0 ? obstacles_serve_ && start_sweep_ <= serve_radius() : served(from, pa);
+  if (move_served) {
+    const double bound = (from_start && start_sweep_ >= 0.0 ? start_sweep_ : served_sweep_) + (step_move.size() > 0 ? step_move.maxCoeff() : 0.0);
+    if (bound <= serve_radius()) {
+      served_velocity_ = to;
+      served_known_ = true;
+      served_sweep_ = bound;
+    } else {
+      move_served = served(to, pb);
+    }
+  }
   const std::vector<Candidate>* cands = &cands_;
   std::vector<Candidate> own;
-  if (!(served(from, pa) && served(to, pb))) {
+  if (!move_served) {
     ContactCounters scratch;
     own = search_.find(pa, pb, step.o0, step.o1, step.obstacle_boxes_current, settings_.thickness, scratch);
     cands = &own;
@@ -634,7 +665,6 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
   std::optional<ReferenceBounds> reference;
   if (cands == &cands_) reference.emplace(reference_bounds(step, pa, &pb, false));
   const double obstacle_motion = reference ? reference->obstacle_motion : 0.0;
-  const Eigen::VectorXd step_move = (pb - pa).rowwise().norm();  // per point, over the move
   const std::vector<double>* lower = reference ? &reference->bounds.lower : nullptr;
   // (Hits are rare: the smallest fraction is kept under a lock rather than per candidate.)
   double alpha = 1.0;

@@ -93,10 +93,11 @@ class BarrierPotential {
   const Eigen::MatrixX3d* end_points(const Eigen::VectorXd& v) const;
   // Checks, once per step, whether the obstacles' motion over the step is served.
   void check_obstacles_serve(const StepPositions& step);
-  // Whether the candidates serve surface points p (and, when not null, q: any move between the
-  // two), with the obstacles anywhere over the step.
-  bool serves(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d* q) const;
-  // The same for the end points p of velocities v, remembering the last velocities found served.
+  // Whether the candidates serve surface points p and q (and any move between the two), with the
+  // obstacles anywhere over the step; their sweep distances (below) in sp and sq when they do.
+  bool serves(const Eigen::MatrixX3d& p, const Eigen::MatrixX3d& q, double& sp, double& sq) const;
+  // The same for the end points p of velocities v, remembering the last velocities found served
+  // (and a bound of their sweep distance, served_sweep_).
   bool served(const Eigen::VectorXd& v, const Eigen::MatrixX3d& p);
   const std::vector<Candidate>& candidates() const { return cands_; }
   // The candidates' distance bounds at the reference (the last linearisation's end points, else
@@ -177,6 +178,11 @@ class BarrierPotential {
   bool obstacles_serve_ = false;       // the obstacles over this step (check_obstacles_serve)
   Eigen::VectorXd served_velocity_;
   bool served_known_ = false;          // served_velocity_'s end points are served by the candidates
+  // Upper bounds of sweep_distance for served_velocity_'s end points and for the step's start
+  // points (−1: not known) [m]. A move of every point by at most m changes a sweep distance by at
+  // most m, so a Newton step from a served iterate is known served without a pass over the points
+  // while its largest point move keeps the bound within serve_radius().
+  double served_sweep_ = 0.0, start_sweep_ = -1.0;
 
   // Per candidate: its geometry at the start of the step (known or not), whether it is within the
   // thickness there, and a near pair's reach (−1 until needed).

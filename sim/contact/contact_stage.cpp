@@ -366,7 +366,8 @@ struct ContactStage::Impl {
       // here only the fail-safe, on the potential's candidates where they serve this step's motion.
       // (Within the potential's step its start is served: begin_step checked it, or made the
       // candidates from it.)
-      if (same_step ? potential->served(v, p1) : potential->serves(positions.p0, &p1)) {
+      double start_sweep = 0.0, end_sweep = 0.0;
+      if (same_step ? potential->served(v, p1) : potential->serves(positions.p0, p1, start_sweep, end_sweep)) {
         cands = &potential->candidates();  // (read in place, not copied)
         use_bounds = true;
       } else {
