@@ -130,15 +130,17 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
   // Φ(v) = ½ vᵀ A v − bᵀ v + E(x + h v) + h Ψ(v) (step_potential.hpp).
   const Eigen::VectorXd ones = Eigen::VectorXd::Ones(n3);
   Eigen::VectorXd product(n3);
-  auto merit = [&](const Eigen::VectorXd& w, const PotentialLinearisation& l) {
-    symmetric_product(a, w, ones, product);
+  // (`product` holds A w after a call; product_at_v: it holds A v for the current iterate v.)
+  bool product_at_v = false;
+  auto merit = [&](const Eigen::VectorXd& w, const PotentialLinearisation& l, bool product_known = false) {
+    if (!product_known) symmetric_product(a, w, ones, product);
     return 0.5 * w.dot(product) - b.dot(w) + l.energy + h * l.dissipation;
   };
   double phi = 0.0;
   bool phi_known = false;  // (Φ is needed once the potential is something at either end of a step)
   LinearSolveReport total;
   total.converged = true;
-  Eigen::VectorXd rhs(n3), v_new(n3), trial(n3), gradient(n3), estimate(n3);
+  Eigen::VectorXd rhs(n3), v_new(n3), trial(n3), gradient(n3), estimate(n3), initial_residual(n3);
   PotentialLinearisation next;
   const double tolerance = potential_->velocity_tolerance(h);
   constexpr int kMaxNewton = 12;
@@ -179,7 +181,14 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
         symmetric_product(a, w, ones, y);
         blocks_.add_product(w, y);
       };
-      r = solver_.solve(newton_product, static_cast<double>(a.nonZeros()) + blocks_.product_entries(), newton_matrix, rhs, free_, v_new);
+      // The start's residual rhs − (A + Σ) v from A v (the merit's, which Φ needs anyway) and the
+      // blocks' Σ v = hv made for the right-hand side: the solver need not apply the operator to
+      // the start (a product per Newton iteration less).
+      if (!product_at_v) symmetric_product(a, v, ones, product);
+      product_at_v = true;
+      initial_residual = rhs - (product + hv);
+      r = solver_.solve(newton_product, static_cast<double>(a.nonZeros()) + blocks_.product_entries(), newton_matrix, rhs, free_,
+                        v_new, &initial_residual);
     } else if (blocks_.empty() && solver_.solves_operators() && (coupled_.empty() || coupled_.matrix().nonZeros() == a.nonZeros())) {
       // No blocks, and no couplings in the pattern: A itself (the conjugate-gradient solver leaves
       // it as it is), without copying its values (a quarter of a millisecond per step on the
@@ -216,8 +225,9 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
       v = v_new;
       break;
     }
-    if (!phi_known) phi = merit(v, lin);
+    if (!phi_known) phi = merit(v, lin, product_at_v);
     phi_known = true;
+    product_at_v = false;  // (merit is called at v_new from here on)
     double phi_new = merit(v_new, next);
     auto raises = [&](double value) { return value > phi + 1e-12 * std::abs(phi); };
     for (int halve = 0; halve < 8 && raises(phi_new); ++halve) {
@@ -245,6 +255,7 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
     for (Eigen::Index i = 0; i < n3; ++i)
       if (free_[static_cast<size_t>(i)]) change = std::max(change, std::abs(estimate(i)));
     v = v_new;
+    product_at_v = true;  // (merit() was last called at v_new)
     std::swap(lin, next);
     phi = phi_new;
     // (A solve that took no iteration changed nothing at the linear solver's tolerance: Newton

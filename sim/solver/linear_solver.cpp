@@ -156,7 +156,8 @@ bool LinearSolver::solves_operators() const {
 }
 
 LinearSolveReport LinearSolver::solve(const LinearOperator& product, double product_entries, const MatrixSource& assemble,
-                                      const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x) {
+                                      const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
+                                      const Eigen::VectorXd* initial_residual) {
   if (!solves_operators())
     throw std::logic_error("LinearSolver::solve: a matrix given as an operation needs pcg with the cholesky preconditioner");
   Impl& m = *impl_;
@@ -168,11 +169,14 @@ LinearSolveReport LinearSolver::solve(const LinearOperator& product, double prod
     m.factorize(a, free, r);
     assembled = &a;
   };
+  // (A second solve, after a refactorisation, starts again from the same x: the same residual.)
+  const Eigen::VectorXd start = x;
   auto pcg = [&](int limit, const Preconditioner& factor) {
-    if (factor) return solve_pcg(product, b, free, x, settings_.tolerance, limit, factor);
+    const Eigen::VectorXd* r0 = initial_residual != nullptr && x == start ? initial_residual : nullptr;
+    if (factor) return solve_pcg(product, b, free, x, settings_.tolerance, limit, factor, r0);
     // (no factor: its factorisation, just made, failed; block Jacobi of the matrix it was of)
     if (assembled == nullptr) throw std::logic_error("LinearSolver::solve: no factor and no matrix");
-    return solve_pcg(product, b, free, x, settings_.tolerance, limit, block_jacobi(*assembled, free));
+    return solve_pcg(product, b, free, x, settings_.tolerance, limit, block_jacobi(*assembled, free), r0);
   };
   return pcg_with_factor(pcg, refactor, product_entries, x);
 }

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <memory>
+#include <stdexcept>
 
 namespace clothsim {
 
@@ -136,15 +137,21 @@ PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd&
 }
 
 PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
-                    double tolerance, int max_iterations, const Preconditioner& preconditioner) {
+                    double tolerance, int max_iterations, const Preconditioner& preconditioner,
+                    const Eigen::VectorXd* initial_residual) {
   const Eigen::VectorXd mask = free_mask(free);
   const Preconditioner precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
     preconditioner(r, z);
     z = z.cwiseProduct(mask);
   };
   Eigen::VectorXd r(b.size());
-  a(x, r);
-  r = (b - r).cwiseProduct(mask);
+  if (initial_residual != nullptr) {
+    if (initial_residual->size() != b.size()) throw std::invalid_argument("solve_pcg: the initial residual's size differs from b's");
+    r = initial_residual->cwiseProduct(mask);
+  } else {
+    a(x, r);
+    r = (b - r).cwiseProduct(mask);
+  }
   const LinearOperator apply = [&](const Eigen::VectorXd& p, Eigen::VectorXd& q) {
     a(p, q);
     q = q.cwiseProduct(mask);

@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -138,6 +139,42 @@ TEST(LinearSolverOperator, AssemblesOnlyWhenAFactorIsMade) {
   EXPECT_EQ(assembled, factorizations);
   EXPECT_EQ(assembled, 1);
   EXPECT_TRUE(solver.solves_operators());
+}
+
+// A start's residual given by the caller replaces the solver's product at the start: one product
+// less, the same solution; and a wrong one is not ignored (the solver trusts it).
+TEST(LinearSolverOperator, TakesTheStartsResidualFromTheCaller) {
+  Problem p = make_problem(10);
+  const std::vector<char> free(static_cast<size_t>(p.n3), 1);
+  int products = 0;
+  const LinearOperator product = [&](const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+    ++products;
+    y = p.chain * x + p.coupling * x;
+  };
+  Eigen::SparseMatrix<double> matrix = p.full;
+  const LinearSolver::MatrixSource assemble = [&]() -> Eigen::SparseMatrix<double>& { return matrix; };
+  Eigen::VectorXd b(p.n3), start(p.n3);
+  for (Eigen::Index i = 0; i < p.n3; ++i) b(i) = std::sin(0.7 * static_cast<double>(i)), start(i) = 0.1 * std::cos(1.3 * static_cast<double>(i));
+  const Eigen::VectorXd expected = Eigen::MatrixXd(p.full).ldlt().solve(b);
+
+  LinearSolver plain(cholesky_pcg(), p.n3), given(cholesky_pcg(), p.n3), wrong(cholesky_pcg(), p.n3);
+  Eigen::VectorXd x = start;
+  products = 0;
+  ASSERT_TRUE(plain.solve(product, 1.0, assemble, b, free, x).converged);
+  const int plain_products = products;
+  EXPECT_LT((x - expected).cwiseAbs().maxCoeff(), 1e-8);
+
+  const Eigen::VectorXd r0 = b - Eigen::MatrixXd(p.full) * start;
+  Eigen::VectorXd y = start;
+  products = 0;
+  ASSERT_TRUE(given.solve(product, 1.0, assemble, b, free, y, &r0).converged);
+  EXPECT_EQ(products, plain_products - 1);
+  EXPECT_LT((y - expected).cwiseAbs().maxCoeff(), 1e-8);
+
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(p.n3);  // "the start solves it": nothing to do
+  Eigen::VectorXd z = start;
+  ASSERT_TRUE(wrong.solve(product, 1.0, assemble, b, free, z, &zero).converged);
+  EXPECT_EQ(z, start);
 }
 
 TEST(LinearSolverOperator, RefusesSolversWithoutTheCholeskyFactor) {
