@@ -384,11 +384,15 @@ std::vector<double> BarrierPotential::close_reaches() const {
 // Fills point_move_ with each point's largest distance from the reference; the obstacles' move is
 // 0 where the reference is the last linearisation and the obstacles stand at the end of the step.
 ReferenceBounds BarrierPotential::reference_bounds(const StepPositions& step, const Eigen::MatrixX3d& points,
-                                                   const Eigen::MatrixX3d* other, bool whole_step) {
+                                                   const Eigen::MatrixX3d* other, bool whole_step, const Eigen::VectorXd* moves) {
   const bool lin = lin_bounds_valid_;
   const Eigen::MatrixX3d& ref = lin ? lin_points_ : step.p0;
-  point_move_ = (points - ref).rowwise().norm();
-  if (other != nullptr) point_move_ = point_move_.cwiseMax((*other - ref).rowwise().norm());
+  if (moves != nullptr) {
+    point_move_ = *moves;
+  } else {
+    point_move_ = (points - ref).rowwise().norm();
+    if (other != nullptr) point_move_ = point_move_.cwiseMax((*other - ref).rowwise().norm());
+  }
   const double obstacle = (lin && !whole_step) || step.o0.rows() == 0 ? 0.0 : (step.o1 - step.o0).rowwise().norm().maxCoeff();
   const double largest = point_move_.size() > 0 ? point_move_.maxCoeff() : 0.0;
   const double motion = std::max(2.0 * largest, largest + obstacle);
@@ -485,9 +489,14 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
   out.active = 0;
   out.energy_gradient.setZero(n3);
   out.dissipation_gradient.setZero(n3);
+  // (At the last step bound's end of the move, Newton's next iterate, from the linearisation
+  // that is still the reference: its points and their moves are known.)
+  const bool at_bound = v.size() == bound_to_velocity_.size() && v == bound_to_velocity_;
+  const bool moves_known = at_bound && bound_move_lin_ == lin_serial_;
   if (!(v.size() == p1_velocity_.size() && v == p1_velocity_)) {
-    if (v.size() == bound_to_velocity_.size() && v == bound_to_velocity_) {
-      p1_ = bound_to_points_;  // (the last step bound's end of the move: Newton's next iterate)
+    if (at_bound) {
+      std::swap(p1_, bound_to_points_);
+      bound_to_velocity_.resize(0);  // (its points are p1_ now)
     } else {
       p1_ = end_points_of(step, v);
     }
@@ -500,7 +509,8 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
   // A pair whose distance at the reference (the start, or the last linearisation) exceeds the
   // thickness by more than its points have moved since cannot be within it now (most candidates
   // of a slow or resting cloth); the bound each candidate gets here serves the next call.
-  const ReferenceBounds reference = reference_bounds(step, p1_, nullptr, false);
+  const ReferenceBounds reference =
+      reference_bounds(step, p1_, nullptr, false, moves_known && lin_bounds_valid_ ? &bound_move_ : nullptr);
   const Bounds& bounds = reference.bounds;
   const double obstacle_motion = reference.obstacle_motion, motion = reference.motion;
   // (The candidates not visited keep their bound less the largest motion.)
@@ -533,6 +543,7 @@ void BarrierPotential::linearise(StepPositions& step, const Eigen::VectorXd& v, 
   next.make_close(close_reaches());
   lin_bounds_ = std::move(next);
   lin_points_ = p1_;
+  ++lin_serial_;
   lin_velocity_ = v;
   lin_time_ = t_ + h_;
   if (settings_.obstacles_static) {
@@ -620,10 +631,21 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
   // (Velocities zero, as where Newton's start is checked from the held start with nothing
   // prescribed, end where the step starts: p0 + h J 0 = p0.)
   const bool from_start = !at_linearisation && from.size() == x_.size() && (from.array() == 0.0).all();
-  const Eigen::MatrixX3d pa = at_linearisation ? lin_points_ : from_start ? step.p0 : points_of(from), pb = points_of(to);
+  // (References, not copies: the move's start is the last linearisation's or the step's, and its
+  // end is kept as bound_to_points_ for the next linearisation.)
+  Eigen::MatrixX3d pa_own;
+  const Eigen::MatrixX3d& pa = at_linearisation ? lin_points_ : from_start ? step.p0 : (pa_own = points_of(from));
+  if (const Eigen::MatrixX3d* known = end_points(to)) {
+    bound_to_points_ = *known;
+  } else {
+    bound_to_points_ = end_points_of(step, to);
+  }
+  const Eigen::MatrixX3d& pb = bound_to_points_;
   bound_to_velocity_ = to;
-  bound_to_points_ = pb;
-  const Eigen::VectorXd step_move = (pb - pa).rowwise().norm();  // per point, over the move
+  bound_move_ = (pb - pa).rowwise().norm();  // per point, over the move
+  const Eigen::VectorXd& step_move = bound_move_;
+  // (From the linearisation that is the reference, these are the moves from it: pa is lin_points_.)
+  bound_move_lin_ = at_linearisation ? lin_serial_ : -1;
   // Candidates for the move pa → pb: the potential's where they serve it, else a broad phase over
   // this move. (pb is served when pa's sweep bound plus the largest point move is within the
   // serve radius: no pass over the points.)
@@ -663,7 +685,7 @@ double BarrierPotential::step_bound(StepPositions& step, const Eigen::VectorXd& 
   // With the potential's candidates, a pair whose distance bound at the reference exceeds the
   // separation by more than its points move (to either end of the move) is skipped.
   std::optional<ReferenceBounds> reference;
-  if (cands == &cands_) reference.emplace(reference_bounds(step, pa, &pb, false));
+  if (cands == &cands_) reference.emplace(reference_bounds(step, pa, &pb, false, at_linearisation ? &bound_move_ : nullptr));
   const double obstacle_motion = reference ? reference->obstacle_motion : 0.0;
   const std::vector<double>* lower = reference ? &reference->bounds.lower : nullptr;
   // (Hits are rare: the smallest fraction is kept under a lock rather than per candidate.)

@@ -104,8 +104,10 @@ class BarrierPotential {
   // the step's start) for surface points `points` (and `other`: any move between the two), with
   // the obstacles where they are at the end of the step or, with `whole_step`, anywhere over it.
   // The result refers to the potential's own storage, valid until its next call.
+  // `moves`, when given, are the points' moves from the reference, known already (per point, the
+  // larger of points' and other's).
   ReferenceBounds reference_bounds(const StepPositions& step, const Eigen::MatrixX3d& points, const Eigen::MatrixX3d* other,
-                                   bool whole_step);
+                                   bool whole_step, const Eigen::VectorXd* moves = nullptr);
   // How many times the candidates were made (a broad phase grown by twice the thickness).
   long long candidate_builds() const { return builds_; }
   // The radius of motion around the path the candidates were made for that they serve [m].
@@ -202,6 +204,11 @@ class BarrierPotential {
   Eigen::MatrixX3d lin_o1_;          // the obstacle vertices there (sized only, when they are static)
   Eigen::VectorXd bound_to_velocity_;  // the last step bound's velocities at the end of its move
   Eigen::MatrixX3d bound_to_points_;   // ... and their end points
+  // The last step bound's per-point moves (|end − start|), and the linearisation it started from
+  // (lin_serial_ then; −1: not from a linearisation): Newton's next linearisation, at its end,
+  // has these as its moves from the reference.
+  Eigen::VectorXd bound_move_;
+  long long bound_move_lin_ = -1, lin_serial_ = 0;  // (lin_serial_ counts the changes of lin_points_)
   Eigen::VectorXd point_move_;       // per surface point, its move from the reference [m]
 
   // The step's effective masses: per node its scale s_k, per surface point its mass (NaN until made).
