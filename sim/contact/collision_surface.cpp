@@ -64,6 +64,11 @@ Eigen::MatrixX3d CollisionSurface::points(const Eigen::VectorXd& x) const {
   return p;
 }
 
+Eigen::MatrixX3d CollisionSurface::points_through_rows(const Eigen::VectorXd& x) const {
+  if (!in_node_form_) return points(x);
+  return end_points(rest_, 1.0, x - d_.rest());
+}
+
 Eigen::MatrixX3d CollisionSurface::end_points(const Eigen::MatrixX3d& p0, double h, const Eigen::VectorXd& v) const {
   Eigen::MatrixX3d out(p0.rows(), 3);
   if (in_node_form_) {

@@ -310,7 +310,9 @@ struct ContactStage::Impl {
   // The surface points and obstacle vertices at the start of the step (and the obstacles' at its
   // end); the end points are to be made from the velocities.
   void start_positions(const Eigen::VectorXd& x, double t) {
-    positions.p0 = surf.points(x);
+    // (Through the point rows where they are in node form: the crushed sleeve's start points took
+    // a twentieth of its contact time through the control net.)
+    positions.p0 = surf.points_through_rows(x);
     end_points_current = false;
     const bool placed = obstacles_static && positions.o0.rows() == static_cast<Eigen::Index>(obs.obstacle_of_vertex.size());
     if (!placed) positions.obstacle_boxes_current = false;

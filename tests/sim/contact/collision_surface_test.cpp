@@ -12,6 +12,7 @@
 #include "sim/contact/collision_surface.hpp"
 
 #include "sim/flat_fe/flat_fe.hpp"
+#include "sim/loop_shell/loop_shell.hpp"
 #include "sim/shell/material_presets.hpp"
 #include "sim/mesh/generators.hpp"
 
@@ -93,6 +94,31 @@ TEST(ContactSurface, EndPointsThroughTheJacobianAreThePointsOfTheMovedNodes) {
   s.make_point_rows();
   ASSERT_TRUE(s.point_rows_in_node_form());  // all nodes free: J = S ⊗ I₃
   EXPECT_LT((s.end_points(p0, h, v) - expected).cwiseAbs().maxCoeff(), 1e-15);  // through the rows
+}
+
+// The surface is linear in the nodes, ghost layer and tied borders included: the rest points
+// moved by J (x − x_rest) are the points at x, on a Loop plate with hinged and free borders (its
+// ghost layer) and a large deformation.
+TEST(ContactSurface, PointsThroughTheRowsAreThePointsOfTheNodes) {
+  const TriMesh grid = make_grid(0.1, 0.08, 6, 5);
+  std::vector<BoundaryCondition> bc(2);
+  for (int v = 0; v < grid.num_vertices(); ++v) {
+    if (grid.vertices(v, 0) < 1e-9) bc[0].vertices.push_back(v);
+    if (grid.vertices(v, 1) < 1e-9) bc[1].vertices.push_back(v);
+  }
+  // (both hinged, all components held; clamped and symmetric borders tie components of a ghost
+  // node to others unevenly, and their rows are not of node form: the stage keeps points() there)
+  const LoopShellDiscretization d(grid, bc, cloth(), Quadrature::one_point);
+  CollisionSurface s(d, 2);
+  s.make_point_rows();
+  ASSERT_TRUE(s.point_rows_in_node_form());
+  Eigen::VectorXd u = random_vector(3 * d.num_nodes(), 5, 0.02);
+  d.make_consistent(u);  // (tied components follow their rule, as in every state the stage sees)
+  const Eigen::VectorXd x = d.rest() + u;
+  const Eigen::MatrixX3d expected = s.points(x), through = s.points_through_rows(x);
+  ASSERT_EQ(through.rows(), expected.rows());
+  EXPECT_LT((through - expected).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_GT((expected - s.rest_points()).cwiseAbs().maxCoeff(), 1e-3);  // (and it did move)
 }
 
 TEST(ContactSurface, PointRowsArePartitionsOfUnityAndPairRowsGiveRelativeVelocities) {
