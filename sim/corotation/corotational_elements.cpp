@@ -209,9 +209,8 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
         double* strain = strain_.data() + strain_offset_[point];
         Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic>>(strain, 3, 3 * np) = m;
         Eigen::Map<Eigen::Matrix<double, 3, Eigen::Dynamic>>(strain + 9 * np, 3, 3 * np) = b;
-        const Eigen::Matrix3d h = material_matrix(s, model.material().poisson_ratio);
-        membrane_material_[point] = model.material().membrane_stiffness() * h;
-        bending_material_[point] = model.material().bending_stiffness() * h;
+        // (isotropic: K_m H and D_b H exactly as before; orthotropic: the law about el.warp)
+        material_matrices(s, model.material(), el.warp, membrane_material_[point], bending_material_[point]);
         area_weight_[point] = el.weights[q] * s.j;
       }
     }

@@ -19,6 +19,13 @@ using Triangle = std::array<int, 3>;
 struct TriMesh {
   Eigen::MatrixX3d vertices;        // #V × 3 rest positions [m]
   std::vector<Triangle> triangles;  // vertex indices, counter-clockwise
+  // Per triangle, the rest warp (grain) direction of a woven material [unit 3-vector, in or near
+  // the triangle's plane], or empty when the mesh has none (docs/materials.md, Grain). Only an
+  // orthotropic material reads it; it is projected into the surface's tangent plane where used.
+  std::vector<Eigen::Vector3d> warp;
+  // Per triangle, the texture coordinates (u, v) of its three corners (OBJ `vt`), or empty when
+  // the mesh has none (read_obj fills it only when every face gives them). Used for the grain.
+  std::vector<std::array<Eigen::Vector2d, 3>> uv;
 
   int num_vertices() const { return static_cast<int>(vertices.rows()); }
   int num_triangles() const { return static_cast<int>(triangles.size()); }

@@ -5,6 +5,8 @@
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
+#include <stdexcept>
+
 namespace clothsim {
 
 SurfacePoint surface_point(const BasisMatrix& basis, const Eigen::MatrixX3d& x) {
@@ -33,6 +35,42 @@ Eigen::Matrix3d material_matrix(const SurfacePoint& s, double nu) {
   h(2, 0) = h(0, 2);
   h(2, 1) = h(1, 2);
   return h;
+}
+
+Eigen::Matrix3d curvilinear_matrix(const SurfacePoint& s, const Eigen::Vector3d& warp, const Eigen::Matrix3d& law) {
+  const Eigen::Vector3d in_plane = warp - warp.dot(s.a3) * s.a3;
+  if (!(in_plane.norm() > 1e-6 * warp.norm()))
+    throw std::invalid_argument("the warp direction is normal to the surface (or zero): no grain to measure from");
+  const Eigen::Vector3d g1 = in_plane.normalized(), g2 = s.a3.cross(g1);
+  Eigen::Matrix2d metric;
+  metric << s.a1.dot(s.a1), s.a1.dot(s.a2), s.a1.dot(s.a2), s.a2.dot(s.a2);
+  const Eigen::Matrix2d inv = metric.inverse();
+  const Eigen::Vector3d dual1 = inv(0, 0) * s.a1 + inv(0, 1) * s.a2, dual2 = inv(1, 0) * s.a1 + inv(1, 1) * s.a2;
+  Eigen::Matrix2d t;  // t(α, i) = a^α · g_i
+  t << dual1.dot(g1), dual1.dot(g2), dual2.dot(g1), dual2.dot(g2);
+  // Row p = (α, β) of the Voigt pairs (11, 22, 12): the products t_αi t_βj summed over the pairs
+  // (i, j) of each Voigt index (both orders for the shear), so that H = T law Tᵀ.
+  Eigen::Matrix3d m;
+  const int first[3] = {0, 1, 0}, second[3] = {0, 1, 1};
+  for (int p = 0; p < 3; ++p) {
+    const int a = first[p], b = second[p];
+    m(p, 0) = t(a, 0) * t(b, 0);
+    m(p, 1) = t(a, 1) * t(b, 1);
+    m(p, 2) = t(a, 0) * t(b, 1) + t(a, 1) * t(b, 0);
+  }
+  return m * law * m.transpose();
+}
+
+void material_matrices(const SurfacePoint& s, const ShellMaterial& material, const Eigen::Vector3d& warp,
+                       Eigen::Matrix3d& membrane, Eigen::Matrix3d& bending) {
+  if (!material.orthotropic()) {
+    const Eigen::Matrix3d h = material_matrix(s, material.poisson_ratio);
+    membrane = material.membrane_stiffness() * h;
+    bending = material.bending_stiffness() * h;
+    return;
+  }
+  membrane = curvilinear_matrix(s, warp, material.membrane_law());
+  bending = curvilinear_matrix(s, warp, material.bending_law());
 }
 
 void strain_matrices(const BasisMatrix& basis, const SurfacePoint& s, StrainMatrix& membrane, StrainMatrix& bending) {
@@ -72,13 +110,25 @@ Eigen::Matrix<double, 6, 1> nonlinear_strains(const BasisMatrix& basis, const Ei
 }
 
 ElementMatrix element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
-                                const Eigen::MatrixX3d& rest, const ShellMaterial& material) {
+                                const Eigen::MatrixX3d& rest, const ShellMaterial& material,
+                                const Eigen::Vector3d& warp) {
   const Eigen::Index dofs = 3 * rest.rows();
   ElementMatrix k = ElementMatrix::Zero(dofs, dofs);
   StrainMatrix m, b;
   Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::ColMajor, 3, kMaxPatchDofs> hm_m, hb_b;
   for (size_t q = 0; q < basis.size(); ++q) {
     const SurfacePoint s = surface_point(basis[q], rest);
+    if (material.orthotropic()) {
+      Eigen::Matrix3d hm, hb;
+      material_matrices(s, material, warp, hm, hb);
+      strain_matrices(basis[q], s, m, b);
+      const double scale = weights[q] * s.j;
+      hm_m.noalias() = (scale * hm) * m;
+      hb_b.noalias() = (scale * hb) * b;
+      k.noalias() += m.transpose() * hm_m;
+      k.noalias() += b.transpose() * hb_b;
+      continue;
+    }
     const Eigen::Matrix3d h = material_matrix(s, material.poisson_ratio);
     strain_matrices(basis[q], s, m, b);
     const double scale = weights[q] * s.j;

@@ -38,6 +38,19 @@ SurfacePoint surface_point(const BasisMatrix& basis, const Eigen::MatrixX3d& x);
 // Material law).
 Eigen::Matrix3d material_matrix(const SurfacePoint& s, double poisson_ratio);
 
+// Constitutive matrix in Voigt form in the curvilinear frame for a plane-stress matrix `law` given
+// in the orthonormal frame (g₁, g₂ = a₃ × g₁), g₁ the `warp` direction projected into the tangent
+// plane and normalised (docs/materials.md, transform to curvilinear components):
+// H^{αβγδ} = Σ law_{ijkl} (a^α·g_i)(a^β·g_j)(a^γ·g_k)(a^δ·g_l), a^α the dual (contravariant) basis.
+// Throws std::invalid_argument when `warp` is (nearly) normal to the surface.
+Eigen::Matrix3d curvilinear_matrix(const SurfacePoint& s, const Eigen::Vector3d& warp, const Eigen::Matrix3d& law);
+
+// The membrane and bending matrices (stiffness included) at a point: for an isotropic material
+// K_m·material_matrix(s, ν) and D_b·material_matrix(s, ν) (bit for bit as always; `warp` unused),
+// for an orthotropic one curvilinear_matrix with the material's membrane_law() and bending_law().
+void material_matrices(const SurfacePoint& s, const ShellMaterial& material, const Eigen::Vector3d& warp,
+                       Eigen::Matrix3d& membrane, Eigen::Matrix3d& bending);
+
 // Strain–displacement matrices (3 × 3n) of the linearised membrane and bending strains.
 void strain_matrices(const BasisMatrix& basis, const SurfacePoint& s, StrainMatrix& membrane, StrainMatrix& bending);
 
@@ -47,8 +60,11 @@ void strain_matrices(const BasisMatrix& basis, const SurfacePoint& s, StrainMatr
 Eigen::Matrix<double, 6, 1> nonlinear_strains(const BasisMatrix& basis, const Eigen::MatrixX3d& rest,
                                               const Eigen::MatrixX3d& deformed);
 
-// Σ_q weight_q · j (K_m Mᵀ H M + D_b Bᵀ H B) over the given quadrature points (3n × 3n).
+// Σ_q weight_q · j (K_m Mᵀ H M + D_b Bᵀ H B) over the given quadrature points (3n × 3n); for an
+// orthotropic material Σ_q weight_q · j (Mᵀ H_m M + Bᵀ H_b B) with material_matrices and the
+// element's rest `warp` direction.
 ElementMatrix element_stiffness(const std::vector<BasisMatrix>& basis, const std::vector<double>& weights,
-                                const Eigen::MatrixX3d& rest, const ShellMaterial& material);
+                                const Eigen::MatrixX3d& rest, const ShellMaterial& material,
+                                const Eigen::Vector3d& warp = Eigen::Vector3d::Zero());
 
 }  // namespace clothsim

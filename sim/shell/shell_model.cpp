@@ -76,11 +76,27 @@ ShellModel::ShellModel(const TriMesh& mesh, const ShellMaterial& material,
     : ext_(build_ghost_layer(mesh)), dofs_(ext_, conditions), material_(material) {
   const std::vector<QuadraturePoint> rule = quadrature_points(quadrature);
   elements_.reserve(mesh.triangles.size());
+  if (material.orthotropic() && mesh.warp.size() != mesh.triangles.size())
+    throw std::invalid_argument("an orthotropic material needs a warp direction per triangle (the mesh has " +
+                                std::to_string(mesh.warp.size()) + " for " + std::to_string(mesh.num_triangles()) +
+                                " triangles)");
   for (int t = 0; t < mesh.num_triangles(); ++t) {
     const Triangle& tri = mesh.triangles[t];
     if (irregular_vertex_count(ext_, tri) > 1)
       throw MeshError("triangle " + std::to_string(t) + " has more than one irregular vertex; refine the mesh first");
     elements_.push_back(make_element(ext_, dofs_, tri, rule));
+    if (material.orthotropic()) {
+      elements_.back().warp = mesh.warp[static_cast<size_t>(t)];
+      // Every quadrature point must see the grain (curvilinear_matrix throws otherwise).
+      const ShellElement& el = elements_.back();
+      for (const BasisMatrix& b : el.basis) {
+        const SurfacePoint s = surface_point(b, patch_rows(ext_.rest, el.patch));
+        const Eigen::Vector3d w = el.warp - el.warp.dot(s.a3) * s.a3;
+        if (!(w.norm() > 1e-6 * el.warp.norm()))
+          throw std::invalid_argument("triangle " + std::to_string(t) +
+                                      ": its warp direction is normal to the surface (or zero)");
+      }
+    }
   }
   build_pattern();
   build_colors();
@@ -163,7 +179,7 @@ void ShellModel::scatter_matrix(int e, const Matrix& local, double* values) cons
 
 Eigen::MatrixXd ShellModel::folded_element_stiffness(int e) const {
   const ShellElement& el = elements_[e];
-  const ElementMatrix k = element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_);
+  const ElementMatrix k = element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, el.warp);
   if (el.identity) return k;
   return fold_patch_matrix(el, k);
 }
@@ -179,7 +195,7 @@ Eigen::SparseMatrix<double> ShellModel::stiffness() const {
         const int e = group[i];
         const ShellElement& el = elements_[e];
         if (el.identity)
-          scatter_matrix(e, element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_), values);
+          scatter_matrix(e, element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, el.warp), values);
         else
           scatter_matrix(e, folded_element_stiffness(e), values);
       }
@@ -189,7 +205,7 @@ Eigen::SparseMatrix<double> ShellModel::stiffness() const {
 
 Eigen::MatrixXd ShellModel::patch_stiffness(int e) const {
   const ShellElement& el = elements_[e];
-  return element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_);
+  return element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, el.warp);
 }
 
 Eigen::VectorXd ShellModel::patch_vector(int e, const Eigen::VectorXd& real) const {

@@ -33,6 +33,7 @@ struct ShellElement {
   std::vector<double> weights;      // quadrature weights (sum 1/2)
   std::vector<int> real;            // real vertices the patch's displacements depend on
   bool identity = false;            // patch == real and every component free and itself
+  Eigen::Vector3d warp = Eigen::Vector3d::Zero();  // rest warp direction (TriMesh::warp; zero: none)
   Eigen::SparseMatrix<double> fold;  // 3·#patch × 3·#real weights (when !identity; most rows
                                      // are unit rows)
 };
@@ -46,6 +47,8 @@ std::vector<std::string> free_rigid_motions(const Eigen::Matrix<double, 6, 6>& g
 
 class ShellModel {
  public:
+  // An orthotropic material needs the mesh's per-triangle warp directions (TriMesh::warp; throws
+  // std::invalid_argument naming what is missing otherwise).
   ShellModel(const TriMesh& mesh, const ShellMaterial& material, const std::vector<BoundaryCondition>& conditions,
              Quadrature quadrature);
 

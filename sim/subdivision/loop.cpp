@@ -100,6 +100,11 @@ TriMesh loop_subdivide(const TriMesh& mesh, double corner_angle_deg) {
   TriMesh out;
   out.vertices = step.matrix * mesh.vertices;
   out.triangles = step.triangles;
+  if (!mesh.warp.empty()) {  // each triangle's four children (in order) keep its warp direction
+    out.warp.reserve(4 * mesh.warp.size());
+    for (const Eigen::Vector3d& w : mesh.warp)
+      for (int k = 0; k < 4; ++k) out.warp.push_back(w);
+  }
   return out;
 }
 
