@@ -41,6 +41,10 @@ LinearFeElastic::LinearFeElastic(const LinearFeDiscretization& d, bool corotatio
   const TriMesh& mesh = d.mesh();
   const ShellMaterial& material = d.material();
   const double km = material.membrane_stiffness(), nu = material.poisson_ratio;
+  if (material.orthotropic() && mesh.warp.size() != mesh.triangles.size())
+    throw std::invalid_argument("linear_fe: an orthotropic material needs a warp direction per triangle (the mesh has " +
+                                std::to_string(mesh.warp.size()) + " for " + std::to_string(mesh.triangles.size()) +
+                                " triangles)");
   Eigen::Matrix3d c;
   c << 1.0, nu, 0.0,  //
       nu, 1.0, 0.0,   //
@@ -77,6 +81,16 @@ LinearFeElastic::LinearFeElastic(const LinearFeDiscretization& d, bool corotatio
       b(2, 2 * i) = g[i](1);
       b(2, 2 * i + 1) = g[i](0);
     }
+    if (material.orthotropic()) {
+      // The law about the triangle's warp direction, projected into its rest plane.
+      const Eigen::Vector3d w = mesh.warp[t] - mesh.warp[t].dot(normal) * normal;
+      if (!(w.norm() > 1e-6 * mesh.warp[t].norm()))
+        throw std::invalid_argument("linear_fe: triangle " + std::to_string(t) +
+                                    ": its warp direction is normal to it (or zero)");
+      const Eigen::Vector2d g = (frame.transpose() * w).normalized();
+      k_[t] = area[t] * b.transpose() * law_in_frame(material.membrane_law(), g(0), g(1)) * b;
+      continue;
+    }
     k_[t] = area[t] * b.transpose() * c * b;
   }
   const std::vector<Hinge>& hinges = d.hinges();
@@ -86,7 +100,19 @@ LinearFeElastic::LinearFeElastic(const LinearFeDiscretization& d, bool corotatio
     const HingePositions x = hinge_positions(h, d.rest());
     const double edge2 = (x[1] - x[0]).squaredNorm();
     const double areas = area[static_cast<size_t>(hinges[h].triangle_a)] + area[static_cast<size_t>(hinges[h].triangle_b)];
-    hinge_k_[h] = material.bending_rigidity * edge2 / (2.0 * areas);
+    double rigidity = material.bending_rigidity;
+    if (material.orthotropic()) {
+      // The rigidity of bending across the edge: curvature along m = n × ê, in the frame of
+      // triangle a's warp (its other moments free: the directional rigidity).
+      const size_t ta = static_cast<size_t>(hinges[h].triangle_a);
+      const Frame& f = rest_frame_[ta];
+      const Eigen::Vector3d n = f.col(0).cross(f.col(1));
+      const Eigen::Vector3d w = mesh.warp[ta] - mesh.warp[ta].dot(n) * n;
+      const Eigen::Vector3d g1 = w.normalized(), g2 = n.cross(g1);
+      const Eigen::Vector3d m = n.cross((x[1] - x[0]).normalized());
+      rigidity = directional_modulus(material.bending_law(), m.dot(g1), m.dot(g2));
+    }
+    hinge_k_[h] = rigidity * edge2 / (2.0 * areas);
     rest_angle_[h] = dihedral_angle(x);
   }
   rotation_ = rest_frame_;

@@ -42,6 +42,9 @@ MassSpringDiscretization::MassSpringDiscretization(const TriMesh& mesh, const st
       << "positive areal density and bending rigidity)";
     throw std::runtime_error(s.str());
   }
+  if (material.orthotropic())
+    throw std::runtime_error("mass_spring: an orthotropic material cannot be represented by a spring network (its shear "
+                             "modulus and Poisson ratio follow from the lattice); use loop_kl or linear_fe");
   const TriMesh& m = this->mesh();
   const double stretch_modulus = material.stretch_modulus;
   std::vector<double> area(m.triangles.size());

@@ -49,7 +49,8 @@ class MassSpringDiscretization final : public FlatDiscretization {
   static double bending_length_curvature(const ShellMaterial& material);
 
   // See FlatDiscretization's constructor. `reference_curvature` κ_ref [1/m] of the bending
-  // springs; 0 takes bending_length_curvature(material). Throws std::runtime_error when κ_ref is
+  // springs; 0 takes bending_length_curvature(material). Throws std::runtime_error for an
+  // orthotropic material (a spring network cannot take it: docs/materials.md), when κ_ref is
   // not a positive finite number (0 given and a material without mass), or when two nodes of a
   // spring coincide at rest.
   MassSpringDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary, const ShellMaterial& material,

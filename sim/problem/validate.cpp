@@ -37,6 +37,17 @@ std::optional<ProblemIssue> find_issue(const Problem& p, Analysis analysis) {
                                   "second order when its ends move across it, so a flat spring network has no stiffness "
                                   "against out-of-plane displacements at rest and a linear static analysis has no answer; "
                                   "run the scene as a dynamic one with damping"};
+  // A network of central springs cannot take an orthotropic law (docs/materials.md, What each
+  // method can represent): its shear stiffness and Poisson ratio follow from the lattice.
+  if (p.method == "mass_spring" && p.material.orthotropic())
+    return ProblemIssue{"material", "an orthotropic material (stretch_modulus or bending_rigidity as an object, or an "
+                                    "orthotropic preset) cannot be represented by \"mass_spring\": a network of central "
+                                    "springs has no shear modulus or Poisson ratio of its own to set (they follow from the "
+                                    "lattice), so woven cloth's soft shear would be lost; use \"loop_kl\" or \"linear_fe\""};
+  if (p.material.orthotropic() && p.mesh.warp.size() != p.mesh.triangles.size())
+    return ProblemIssue{"material", "an orthotropic material needs the grain: a warp direction per triangle of the mesh "
+                                    "(the mesh has " + std::to_string(p.mesh.warp.size()) + " for " +
+                                    std::to_string(p.mesh.triangles.size()) + " triangles)"};
   for (size_t i = 0; i < p.boundary.size(); ++i) {
     const BoundaryCondition& bc = p.boundary[i];
     const std::string key = index_key("boundary", i);

@@ -1,0 +1,142 @@
+// The orthotropic law in linear_fe (docs/materials.md, What each method can represent): the
+// membrane CST with the law turned into each triangle's frame, the hinges with the directional
+// rigidity across their edge. The isotropic limit gives the isotropic matrices; with the rotations
+// frozen the force is −∂E/∂x and the matrix −∂f/∂x; strips along warp, weft and bias stretch by
+// the orthotropic membrane formula; mass_spring refuses an orthotropic material.
+#include "sim/flat_fe/flat_fe.hpp"
+#include "sim/flat_fe/flat_fe_term.hpp"
+#include "sim/flat_fe/mass_spring.hpp"
+#include "sim/mesh/generators.hpp"
+#include "sim/problem/validate.hpp"
+#include "sim/scene/scene.hpp"
+#include "sim/static/static_solve.hpp"
+#include "sim/study/plates.hpp"
+#include "tests/support/fd_check.hpp"
+#include "tests/support/term_states.hpp"
+#include "tests/support/test_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace clothsim {
+namespace {
+
+Orthotropy woven() {
+  Orthotropy o;
+  o.warp_stretch = 5000;
+  o.weft_stretch = 3000;
+  o.shear_stretch = 60;
+  o.poisson = 0.25;
+  o.warp_bending = 1.2e-4;
+  o.weft_bending = 0.9e-4;
+  o.twist = 0.5e-4;
+  return o;
+}
+
+void set_warp(TriMesh& mesh, const Eigen::Vector3d& dir) { mesh.warp.assign(mesh.triangles.size(), dir); }
+
+TEST(LinearFeOrthotropic, IsotropicLimitGivesTheIsotropicMatrix) {
+  ShellMaterial iso;
+  iso.stretch_modulus = 5000;
+  iso.bending_rigidity = 1e-4;
+  iso.poisson_ratio = 0.3;
+  iso.areal_density = 0.12;
+  ShellMaterial ortho = iso;
+  ortho.orthotropy = isotropic_orthotropy(iso);
+  TriMesh mesh = make_cylinder(0.03, 0.06, 8, 4);
+  set_warp(mesh, Eigen::Vector3d(0.2, 1.0, 0.4));
+  const LinearFeDiscretization a(mesh, {}, iso), b(mesh, {}, ortho);
+  const Eigen::VectorXd x = testing::perturbed_rest(a, 2e-3, 4);
+  std::unique_ptr<ForceTerm> ta = a.elastic_term(true, false), tb = b.elastic_term(true, false);
+  const Eigen::MatrixXd ka = testing::matrix_at(*ta, a, x, {1.0, 0.0}), kb = testing::matrix_at(*tb, b, x, {1.0, 0.0});
+  EXPECT_LT((ka - kb).norm(), 1e-11 * ka.norm());
+  EXPECT_LT((testing::force_at(*ta, a, x) - testing::force_at(*tb, b, x)).norm(), 1e-11 * testing::force_at(*ta, a, x).norm());
+}
+
+TEST(LinearFeOrthotropic, ForceAndMatrixMatchFiniteDifferencesWithFrozenRotations) {
+  ShellMaterial m;
+  set_orthotropy(m, woven());
+  m.areal_density = 0.12;
+  TriMesh grid = testing::jittered_grid();
+  set_warp(grid, Eigen::Vector3d(std::cos(0.4), std::sin(0.4), 0));
+  TriMesh sleeve = make_cylinder(0.03, 0.06, 8, 4);
+  set_warp(sleeve, Eigen::Vector3d::UnitY());
+  for (const TriMesh* mesh : {&grid, &sleeve}) {
+    const LinearFeDiscretization d(*mesh, {}, m);
+    const std::vector<testing::State> all = testing::states(d);
+    // At rest the force is zero: errors there are measured against the first random state's force.
+    std::unique_ptr<ForceTerm> scale_term = d.elastic_term(true, true);
+    const double floor = testing::force_at(*scale_term, d, all[1].x).cwiseAbs().maxCoeff();
+    for (const testing::State& state : all) {
+      std::unique_ptr<ForceTerm> term = d.elastic_term(true, true);
+      testing::update_at(*term, d, state.x);
+      auto& fe = dynamic_cast<LinearFeElastic&>(*term);
+      fe.freeze_rotations(true);
+      fe.set_exact_bending_hessian(true);
+      testing::FdReport e = testing::check_force_against_energy(*term, d, state.x, 1e-6);
+      e.floor = floor;
+      EXPECT_LT(e.relative(), 1e-6) << state.name << ": " << e.describe();
+      const testing::FdReport r = testing::check_matrix_against_force(*term, d, state.x, 1e-6);
+      EXPECT_LT(r.relative(), 1e-6) << state.name << ": " << r.describe();
+    }
+  }
+}
+
+double directional_compliance(double ew, double ef, double g, double nu, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  return std::pow(c, 4) / ew + std::pow(s, 4) / ef + (1.0 / g - 2.0 * nu / ew) * s * s * c * c;
+}
+
+TEST(LinearFeOrthotropic, StripElongationAlongWarpWeftAndBiasMatchesTheMembraneFormula) {
+  const double length = 0.2, width = 0.04, force = 0.02;
+  for (double deg : {0.0, 90.0, 45.0}) {
+    const double angle = deg * M_PI / 180.0;
+    Problem p;
+    p.method = "linear_fe";
+    p.mesh = make_grid(length, width, 40, 8);
+    set_warp(p.mesh, Eigen::Vector3d(std::cos(angle), std::sin(angle), 0));
+    set_orthotropy(p.material, woven());
+    BoundaryCondition roller, pin, flat;
+    roller.vertices = select_vertices(p.mesh, [&](const auto& x) { return x(0) < -length / 2 + 1e-9; });
+    roller.fix = {true, false, false};
+    pin.vertices = {nearest_vertex(p.mesh, Eigen::Vector3d(-length / 2, 0, 0))};
+    pin.fix = {false, true, false};
+    flat.vertices = select_vertices(p.mesh, [](const auto&) { return true; });
+    flat.fix = {false, false, true};
+    p.boundary = {roller, pin, flat};
+    const std::vector<int> tip = select_vertices(p.mesh, [&](const auto& x) { return x(0) > length / 2 - 1e-9; });
+    for (size_t i = 0; i < tip.size(); ++i) {
+      const double share = (i == 0 || i + 1 == tip.size()) ? 0.5 : 1.0;
+      p.point_loads.push_back({tip[i], Eigen::Vector3d(share * force / static_cast<double>(tip.size() - 1), 0, 0)});
+    }
+    const StaticResult r = solve_static(p);
+    const int a = nearest_vertex(p.mesh, Eigen::Vector3d(-length / 4, 0, 0)), b = nearest_vertex(p.mesh, Eigen::Vector3d(length / 4, 0, 0));
+    const double strain = (r.limit_displacement(b, 0) - r.limit_displacement(a, 0)) / (r.limit_rest(b, 0) - r.limit_rest(a, 0));
+    const double expected = force / width * directional_compliance(5000, 3000, 60, 0.25, angle);
+    std::printf("linear_fe strip at %g deg to the warp: strain %.6e, formula %.6e, error %.3f%%\n", deg, strain, expected,
+                100 * (strain / expected - 1));
+    EXPECT_NEAR(strain / expected, 1.0, 0.03) << deg << " deg";
+  }
+}
+
+TEST(MassSpringOrthotropic, IsRefusedNamingTheMaterial) {
+  ShellMaterial m;
+  set_orthotropy(m, woven());
+  m.areal_density = 0.12;
+  TriMesh mesh = make_grid(0.1, 0.1, 4, 4);
+  set_warp(mesh, Eigen::Vector3d::UnitX());
+  EXPECT_THROW(MassSpringDiscretization(mesh, {}, m), std::runtime_error);
+  Problem p;
+  p.method = "mass_spring";
+  p.mesh = mesh;
+  p.material = m;
+  const auto issue = find_issue(p, Analysis::dynamics);
+  ASSERT_TRUE(issue.has_value());
+  EXPECT_EQ(issue->key, "material");
+  EXPECT_NE(issue->message.find("mass_spring"), std::string::npos) << issue->message;
+}
+
+}  // namespace
+}  // namespace clothsim
