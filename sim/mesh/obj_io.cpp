@@ -58,6 +58,7 @@ bool parse_integer(std::string_view token, long long& value) {
 struct FaceCorner {
   long long index;    // 0-based; a positive file index is range-checked once all vertices are read
   long long written;  // the index as written in the file, for error messages
+  long long texture = -1;  // 0-based texture-coordinate index (`i/t`, `i/t/n`), or -1 (none / out of range)
 };
 
 struct PendingTriangle {
@@ -115,6 +116,7 @@ TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertic
   // genus g: 2V + 4g - 4); four times is room for any practical mesh.
   const long long max_triangles = 4 * max_vertices;
   std::vector<std::array<double, 3>> positions;
+  std::vector<std::array<double, 2>> texcoords;  // `vt u v`
   std::vector<PendingTriangle> pending;
   std::string text;
   long long line_number = 0;
@@ -147,6 +149,18 @@ TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertic
         throw MeshLimitError(path + ":" + std::to_string(line_number) + ": more than " + std::to_string(max_vertices) +
                              " vertices");
       positions.push_back(p);
+    } else if (tokens[0] == "vt") {
+      // u [v [w]]; a malformed or non-finite one is kept as unusable (NaN), as vt was ignored before.
+      std::array<double, 2> t{std::nan(""), std::nan("")};
+      if (tokens.size() >= 3 && parse_double(tokens[1], t[0]) && parse_double(tokens[2], t[1]) && std::isfinite(t[0]) &&
+          std::isfinite(t[1])) {
+      } else {
+        t = {std::nan(""), std::nan("")};
+      }
+      if (static_cast<long long>(texcoords.size()) >= max_triangles)
+        throw MeshLimitError(path + ":" + std::to_string(line_number) + ": more than " + std::to_string(max_triangles) +
+                             " texture coordinates (4 x the limit of " + std::to_string(max_vertices) + " vertices)");
+      texcoords.push_back(t);
     } else if (tokens[0] == "f") {
       if (tokens.size() < 4)
         fail(path, line_number, "malformed face line: a face needs at least 3 vertices, found " +
@@ -158,19 +172,25 @@ TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertic
         // Forms: i, i/t, i//n, i/t/n. Only i is used, but t and n must be integers if present.
         long long index = 0;
         long long ignored = 0;
+        long long texture = 0;  // as written; 0: none
         const std::size_t slash = entry.find('/');
         bool well_formed = parse_integer(entry.substr(0, slash), index);
         if (well_formed && slash != std::string_view::npos) {
           const std::string_view rest = entry.substr(slash + 1);
           const std::size_t second = rest.find('/');
           if (second == std::string_view::npos) {
-            well_formed = parse_integer(rest, ignored);  // i/t
+            well_formed = parse_integer(rest, texture);  // i/t
           } else {
-            const std::string_view texture = rest.substr(0, second);  // empty in i//n
-            well_formed = (texture.empty() || parse_integer(texture, ignored)) &&
-                          parse_integer(rest.substr(second + 1), ignored);
+            const std::string_view tex = rest.substr(0, second);  // empty in i//n
+            well_formed = (tex.empty() || parse_integer(tex, texture)) && parse_integer(rest.substr(second + 1), ignored);
           }
         }
+        // The texture index resolved like the vertex index; unusable ones give -1 (no uv).
+        long long texture_index = -1;
+        if (texture > 0 && texture <= static_cast<long long>(texcoords.size()))
+          texture_index = texture - 1;
+        else if (texture < 0 && static_cast<long long>(texcoords.size()) + texture >= 0)
+          texture_index = static_cast<long long>(texcoords.size()) + texture;
         if (!well_formed) fail(path, line_number, "malformed face entry '" + std::string(entry) + "'");
         if (index == 0) fail(path, line_number, "face index 0 is invalid (OBJ indices start at 1)");
         if (index < 0) {
@@ -179,9 +199,9 @@ TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertic
           if (resolved < 0)
             fail(path, line_number, "face index " + std::to_string(index) + " out of range (only " +
                                   std::to_string(positions.size()) + " vertices defined before this line)");
-          corners.push_back({resolved, index});
+          corners.push_back({resolved, index, texture_index});
         } else {
-          corners.push_back({index - 1, index});
+          corners.push_back({index - 1, index, texture_index});
         }
       }
       // Fan triangulation around the first corner.
@@ -191,7 +211,7 @@ TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertic
       for (std::size_t k = 1; k + 1 < corners.size(); ++k)
         pending.push_back({{corners[0], corners[k], corners[k + 1]}, line_number});
     }
-    // Everything else (vn, vt, vp, o, g, s, l, usemtl, mtllib, ...) is ignored.
+    // Everything else (vn, vp, o, g, s, l, usemtl, mtllib, ...) is ignored.
   }
   if (in.bad()) throw MeshError(path + ": read error");
 
@@ -212,6 +232,22 @@ TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertic
   for (const PendingTriangle& tri : pending)
     mesh.triangles.push_back({static_cast<int>(tri.corners[0].index), static_cast<int>(tri.corners[1].index),
                               static_cast<int>(tri.corners[2].index)});
+  // Texture coordinates, when every corner of every face names a usable one.
+  bool textured = !texcoords.empty();
+  for (const PendingTriangle& tri : pending)
+    for (const FaceCorner& corner : tri.corners)
+      if (corner.texture < 0 || !std::isfinite(texcoords[static_cast<std::size_t>(corner.texture)][0])) textured = false;
+  if (textured) {
+    mesh.uv.reserve(pending.size());
+    for (const PendingTriangle& tri : pending) {
+      std::array<Eigen::Vector2d, 3> uv;
+      for (int k = 0; k < 3; ++k) {
+        const auto& t = texcoords[static_cast<std::size_t>(tri.corners[static_cast<std::size_t>(k)].texture)];
+        uv[static_cast<std::size_t>(k)] = Eigen::Vector2d(t[0], t[1]);
+      }
+      mesh.uv.push_back(uv);
+    }
+  }
 
   try {
     check_triangles(mesh);

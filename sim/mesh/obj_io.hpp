@@ -1,5 +1,6 @@
-// Reading and writing triangle meshes in the Wavefront OBJ format (geometry only: vertex
-// positions and faces; normals, texture coordinates, groups and materials are ignored).
+// Reading and writing triangle meshes in the Wavefront OBJ format (geometry and texture
+// coordinates: vertex positions, faces and `vt`, the latter only for the grain of a woven
+// material; normals, groups and materials are ignored).
 #pragma once
 
 #include "sim/mesh/mesh.hpp"
@@ -17,7 +18,9 @@ namespace clothsim {
 // Reads the `v x y z` and `f ...` lines of an OBJ file. Face entries may be `i`, `i/t`, `i//n`
 // or `i/t/n`, with 1-based or negative (relative to the vertices read so far) indices; polygons
 // with more than three corners are fan-triangulated as (c0, ck, ck+1). All other line types are
-// ignored. Positions are taken as metres [m].
+// ignored, but `vt u v` lines and the faces' texture indices fill TriMesh::uv when every face
+// corner names a valid, finite one (otherwise uv stays empty: texture coordinates never make a file
+// fail). Positions are taken as metres [m].
 //
 // Throws MeshError naming the file and, for parse errors, the line ("mesh.obj:12: face index
 // 40 out of range (file has 10 vertices)"). The parsed mesh is then validated with

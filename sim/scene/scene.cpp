@@ -8,6 +8,7 @@
 #include "sim/mesh/imperfection.hpp"
 
 #include "sim/mesh/generators.hpp"
+#include "sim/mesh/grain.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/problem/validate.hpp"
 #include "sim/setup/setup.hpp"
@@ -517,8 +518,32 @@ void check_vertex_count(const Reader& r, const std::string& path, const std::str
                      std::to_string(max_vertices) + " (raise mesh.max_vertices to allow it)");
 }
 
+// "material.grain": {"warp_deg": deg} (docs/materials.md, Grain): how the warp lies on the mesh.
+struct GrainSpec {
+  bool given = false;     // the key is present
+  double warp_deg = 0.0;  // [deg], from the mesh's reference direction
+};
+
+// The grain of an OBJ mesh: from its texture coordinates, or an error naming what is missing
+// when the scene needs one (`need`: an orthotropic material or a "grain" key).
+void obj_grain(const Reader& r, TriMesh& mesh, const GrainSpec& grain, bool need, const std::string& file) {
+  if (!need) return;
+  if (mesh.uv.empty()) {
+    if (grain.given)
+      r.fail("material.grain", "the mesh " + quote(file) +
+                                   " has no texture coordinates (vt on every face) to measure the grain from");
+    r.fail("material", "an orthotropic material needs the grain direction, and the mesh " + quote(file) +
+                           " has no texture coordinates (vt on every face) to measure it from");
+  }
+  try {
+    mesh.warp = uv_warp(mesh, grain.warp_deg);
+  } catch (const std::exception& e) {
+    r.fail(grain.given ? "material.grain" : "material", quote(file) + ": " + e.what());
+  }
+}
+
 TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log,
-                         long long max_vertices) {
+                         long long max_vertices, const GrainSpec& grain, bool need_grain) {
   const std::string path = "mesh";
   if (!j.is_object()) r.fail(path, "expected an object (got " + describe(j) + ")");
   const bool has_obj = j.contains("obj");
@@ -537,7 +562,10 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
       TriMesh mesh = read_obj(obj.string(), max_vertices);
       log("mesh: " + obj.string() + ": " + std::to_string(mesh.num_vertices()) + " vertices, " +
           std::to_string(mesh.num_triangles()) + " triangles");
+      obj_grain(r, mesh, grain, need_grain, name);
       return mesh;
+    } catch (const SceneError&) {
+      throw;
     } catch (const MeshLimitError& e) {
       r.fail(key, std::string(e.what()) + " (mesh.max_vertices = " + std::to_string(max_vertices) +
                       "; raise it to read larger meshes)");
@@ -560,6 +588,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
       check_vertex_count(r, "mesh.divisions", "a " + std::to_string(dx) + " x " + std::to_string(dy) + " grid",
                          (static_cast<long long>(dx) + 1) * (static_cast<long long>(dy) + 1), max_vertices);
       mesh = make_grid(sx, sy, dx, dy);
+      if (need_grain) mesh.warp = grid_warp(mesh, grain.warp_deg);
       log("mesh: grid " + format_number(sx) + " m x " + format_number(sy) + " m, " + std::to_string(dx) +
           " x " + std::to_string(dy) + " divisions");
     } else {
@@ -581,6 +610,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
                          max_vertices);
       mesh = angle < 360.0 ? make_cylinder_panel(radius, length, angle, segments, rings)
                            : make_cylinder(radius, length, segments, rings);
+      if (need_grain) mesh.warp = cylinder_warp(mesh, grain.warp_deg);
       log("mesh: cylinder r = " + format_number(radius) + " m, L = " + format_number(length) + " m, " +
           (angle < 360.0 ? "open panel of " + format_number(angle) + " deg, " : std::string()) +
           std::to_string(segments) + " segments, " + std::to_string(rings) + " rings");
@@ -596,7 +626,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
 // The mesh with its optional placement: "rotate": {"axis": [x, y, z], "angle_deg": a} about the
 // origin, then "translate": [x, y, z] [m].
 TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log,
-                   long long max_vertices) {
+                   long long max_vertices, const GrainSpec& grain, bool need_grain) {
   if (!j.is_object()) r.fail("mesh", "expected an object (got " + describe(j) + ")");
   Json shape = j;
   shape.erase("max_vertices");  // (read by read_max_vertices)
@@ -614,10 +644,11 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
     translation = r.vec3(*tr, "mesh.translate");
     shape.erase("translate");
   }
-  TriMesh mesh = build_mesh_shape(r, shape, folder, log, max_vertices);
+  TriMesh mesh = build_mesh_shape(r, shape, folder, log, max_vertices, grain, need_grain);
   if (j.contains("rotate") || j.contains("translate")) {
     for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
       mesh.vertices.row(v) = (rotation * mesh.vertices.row(v).transpose() + translation).transpose();
+    for (Eigen::Vector3d& w : mesh.warp) w = rotation * w;  // the grain turns with the mesh
     if (!mesh.vertices.allFinite())
       r.fail(j.contains("translate") ? "mesh.translate" : "mesh.rotate",
              "the placed mesh has a coordinate beyond the range of a double (overflow)");
@@ -626,13 +657,77 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
   return mesh;
 }
 
-ShellMaterial read_material(const Reader& r, const Json* j) {
+// The orthotropic parts of "material" (scenes/README.md, Material): "stretch_modulus" and
+// "bending_rigidity" as objects, or as numbers (isotropic) beside an object or an orthotropic
+// preset. `base` is the material the other keys made (solid or preset); `poisson_json` the
+// "poisson_ratio" key, if given.
+ShellMaterial read_orthotropic(const Reader& r, const Json& j, const ShellMaterial& base, const Json* poisson_json,
+                               double poisson) {
+  Orthotropy o = base.orthotropic() ? *base.orthotropy : isotropic_orthotropy(base);
+  bool twist_set = base.orthotropic();  // an orthotropic preset's twist stays unless its bending is replaced
+  bool membrane_orthotropic = base.orthotropic();
+  const Json* stretch = r.find(j, "stretch_modulus");
+  if (stretch != nullptr && stretch->is_object()) {
+    const std::string path = "material.stretch_modulus";
+    r.check_object(*stretch, path, {"warp", "weft", "shear", "poisson"});
+    o.warp_stretch = r.positive(r.require(*stretch, path, "warp"), path + ".warp", "[N/m]");
+    o.weft_stretch = r.positive(r.require(*stretch, path, "weft"), path + ".weft", "[N/m]");
+    o.shear_stretch = r.positive(r.require(*stretch, path, "shear"), path + ".shear", "[N/m]");
+    o.poisson = r.non_negative(r.require(*stretch, path, "poisson"), path + ".poisson", "[-]");
+    if (!(o.poisson * o.poisson < o.warp_stretch / o.weft_stretch))
+      r.fail(path + ".poisson", "makes the membrane law indefinite: poisson^2 must be < warp/weft = " +
+                                    format_number(o.warp_stretch / o.weft_stretch) + " (got " +
+                                    format_number(o.poisson) + "; nu_warp,weft * nu_weft,warp must be < 1)");
+    membrane_orthotropic = true;
+  } else if (stretch != nullptr) {
+    const double e = r.positive(*stretch, "material.stretch_modulus", "[N/m]");
+    const double nu = poisson_json != nullptr ? poisson : o.poisson;
+    o.warp_stretch = o.weft_stretch = e;
+    o.shear_stretch = e / (2.0 * (1.0 + nu));
+    o.poisson = nu;
+    membrane_orthotropic = false;
+  }
+  if (poisson_json != nullptr && membrane_orthotropic)
+    r.fail("material.poisson_ratio", std::string("cannot be combined with an orthotropic membrane (") +
+                                         (stretch != nullptr ? "stretch_modulus as an object" : "an orthotropic preset") +
+                                         "): give its Poisson ratio as stretch_modulus.poisson");
+  const Json* bending = r.find(j, "bending_rigidity");
+  if (bending != nullptr && bending->is_object()) {
+    const std::string path = "material.bending_rigidity";
+    r.check_object(*bending, path, {"warp", "weft", "twist"});
+    o.warp_bending = r.positive(r.require(*bending, path, "warp"), path + ".warp", "[N·m]");
+    o.weft_bending = r.positive(r.require(*bending, path, "weft"), path + ".weft", "[N·m]");
+    twist_set = false;
+    if (const Json* t = r.find(*bending, "twist")) {
+      o.twist = r.positive(*t, path + ".twist", "[N·m]");
+      twist_set = true;
+    }
+  } else if (bending != nullptr) {
+    o.warp_bending = o.weft_bending = r.positive(*bending, "material.bending_rigidity", "[N·m]");
+    twist_set = false;
+  }
+  if (!twist_set) o.twist = default_twist(o.warp_bending, o.weft_bending, o.poisson);
+  if (!(o.poisson * o.poisson < o.warp_bending / o.weft_bending))
+    r.fail("material.bending_rigidity", "with the membrane's poisson " + format_number(o.poisson) +
+                                            " the bending law is indefinite: poisson^2 must be < warp/weft = " +
+                                            format_number(o.warp_bending / o.weft_bending));
+  ShellMaterial m = base;
+  set_orthotropy(m, o);
+  return m;
+}
+
+ShellMaterial read_material(const Reader& r, const Json* j, GrainSpec& grain) {
   double youngs = 1e7, poisson = 0.3, thickness = 0.001, density = 1000.0;
   if (j == nullptr) return ShellMaterial::from_solid(youngs, poisson, thickness, density);
   const std::string path = "material";
   r.check_object(*j, path,
                  {"preset", "youngs_modulus", "poisson_ratio", "thickness", "density", "stretch_modulus",
-                  "bending_rigidity", "areal_density"});
+                  "bending_rigidity", "areal_density", "grain"});
+  if (const Json* g = r.find(*j, "grain")) {
+    r.check_object(*g, "material.grain", {"warp_deg"});
+    grain.given = true;
+    if (const Json* w = r.find(*g, "warp_deg")) grain.warp_deg = r.number(*w, "material.grain.warp_deg");
+  }
   const Json* preset = r.find(*j, "preset");
   std::string preset_name;
   if (preset != nullptr) {
@@ -657,12 +752,17 @@ ShellMaterial read_material(const Reader& r, const Json* j) {
   ShellMaterial m = ShellMaterial::from_solid(youngs, poisson, thickness, density);
   if (preset != nullptr) {
     m = *material_preset(preset_name);
-    if (poisson_json != nullptr) m.poisson_ratio = poisson;
+    if (poisson_json != nullptr && !m.orthotropic()) m.poisson_ratio = poisson;
   }
-  if (const Json* v = r.find(*j, "stretch_modulus"))
-    m.stretch_modulus = r.positive(*v, "material.stretch_modulus", "[N/m]");
-  if (const Json* v = r.find(*j, "bending_rigidity"))
-    m.bending_rigidity = r.positive(*v, "material.bending_rigidity", "[N·m]");
+  const Json* stretch = r.find(*j, "stretch_modulus");
+  const Json* bending = r.find(*j, "bending_rigidity");
+  const bool object_form = (stretch != nullptr && stretch->is_object()) || (bending != nullptr && bending->is_object());
+  if (object_form || m.orthotropic()) {
+    m = read_orthotropic(r, *j, m, poisson_json, poisson);
+  } else {
+    if (stretch != nullptr) m.stretch_modulus = r.positive(*stretch, "material.stretch_modulus", "[N/m]");
+    if (bending != nullptr) m.bending_rigidity = r.positive(*bending, "material.bending_rigidity", "[N·m]");
+  }
   if (const Json* v = r.find(*j, "areal_density"))
     m.areal_density = r.non_negative(*v, "material.areal_density", "[kg/m²]");
   const std::string problem = validate(m);
@@ -1421,7 +1521,8 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
 
   // Cheap checks first, the mesh (possibly large) after; nothing larger than this is read or made.
   const long long max_vertices = read_max_vertices(r, root);
-  scene.problem.material = read_material(r, r.find(root, "material"));
+  GrainSpec grain;
+  scene.problem.material = read_material(r, r.find(root, "material"), grain);
   scene.problem.quadrature = read_numerics(r, r.find(root, "numerics"));
   Problem& dyn = scene.problem;
   if (dynamic) {
@@ -1447,7 +1548,8 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
                        max_vertices);
   }
   const Json& mesh_json = r.require(root, "", "mesh");
-  TriMesh mesh = build_mesh(r, mesh_json, file.parent_path(), say, max_vertices);
+  TriMesh mesh =
+      build_mesh(r, mesh_json, file.parent_path(), say, max_vertices, grain, grain.given || scene.problem.material.orthotropic());
   warn_about_cracks(mesh, mesh_json.contains("obj"), say);
   // An obstacle's translations too are measured against the cloth (the scene's scale).
   for (std::size_t i = 0; i < scene.problem.obstacles.size(); ++i)

@@ -2,6 +2,7 @@
 // stretch modulus E·t [N/m], bending rigidity B [N·m], Poisson ratio ν [-], areal density [kg/m²].
 #include "sim/shell/material_presets.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -35,6 +36,53 @@ ShellMaterial wang(double c11, double c22, double bending_rigidity, double areal
   return make(std::sqrt(c11 * c22), bending_rigidity, 0.25, areal_density);
 }
 
+// The orthotropic fit of a Wang, Ramamoorthi & O'Brien 2011 cloth (docs/materials.md, Presets)
+// from its small-strain stretching row [c11, c12, c22, c33] [N/m] (the stress–strain matrix of
+// the Green strain with the tensor shear strain ε₁₂, first material axis = warp, as ARCSim's
+// materials/*.json give it) and its bending at the smallest curvature for fold lines along the
+// first axis (b0), at 45° (b45) and along the second axis (b90) [N·m]:
+//   ν_wf = max(c12, 0)/c22 (a negative c12 is a fitting artefact: ν = 0), c12' = ν_wf c22,
+//   E_w = c11 − c12'²/c22, E_f = c22 − c12'²/c11, G = c33/2 (n₁₂ = c33 ε₁₂ = (c33/2) γ₁₂);
+//   B_w = b90 (curvature along the warp: fold lines along the weft), B_f = b0, and the twist from
+//   the 45° rigidity, 1/D_t = 4/b45 − 1/B_w − 1/B_f + 2ν_wf/B_w (positive for all ten cloths).
+ShellMaterial wang_orthotropic(double c11, double c12, double c22, double c33, double b0, double b45, double b90,
+                               double areal_density) {
+  Orthotropy o;
+  o.poisson = std::max(c12, 0.0) / c22;
+  const double coupling = o.poisson * c22;
+  o.warp_stretch = c11 - coupling * coupling / c22;
+  o.weft_stretch = c22 - coupling * coupling / c11;
+  o.shear_stretch = 0.5 * c33;
+  o.warp_bending = b90;
+  o.weft_bending = b0;
+  o.twist = 1.0 / (4.0 / b45 - 1.0 / b90 - 1.0 / b0 + 2.0 * o.poisson / b90);
+  ShellMaterial m;
+  set_orthotropy(m, o);
+  m.areal_density = areal_density;
+  return m;
+}
+
+// 1 gf/cm/deg (Kawabata KES-FB1 shear stiffness G) in N/m per radian: 9.80665e-3 N / 0.01 m per
+// (π/180) rad = 56.19 N/m.
+constexpr double kGfPerCmPerDeg = 9.80665e-3 / 0.01 / (3.14159265358979323846 / 180.0);
+
+// A Kawabata fabric of Matsudaira et al. 2015 as an orthotropic shell: its measured B (the same
+// along warp and weft: Table 1 gives one value) and areal density, the paper's cotton stretch
+// (E·t = 5000 N/m along warp and weft, ν = 0.25: not measured in that table), and a shear
+// modulus G [gf/cm/deg] that is assumed, not measured (see build_presets); default twist.
+ShellMaterial kawabata_orthotropic(double bending_rigidity, double areal_density, double shear_gf_cm_deg) {
+  Orthotropy o;
+  o.warp_stretch = o.weft_stretch = kPaperCottonStretch;
+  o.poisson = kPaperCottonPoisson;
+  o.shear_stretch = shear_gf_cm_deg * kGfPerCmPerDeg;
+  o.warp_bending = o.weft_bending = bending_rigidity;
+  o.twist = default_twist(bending_rigidity, bending_rigidity, o.poisson);
+  ShellMaterial m;
+  set_orthotropy(m, o);
+  m.areal_density = areal_density;
+  return m;
+}
+
 std::vector<Preset> build_presets() {
   std::vector<Preset> p;
   // Paper §6 cotton: E·t = 5000 N/m, ν = 0.25 (the paper gives no bending rigidity or mass);
@@ -66,6 +114,38 @@ std::vector<Preset> build_presets() {
   p.push_back({"tango_red_jet_set", wang(43.1, 171.4, 1.43e-5, 0.113)});      // jacket
   p.push_back({"white_dots_on_black", wang(2002.1, 2027.5, 5.17e-5, 0.128)});  // tablecloth
   p.push_back({"white_swim_solid", wang(48.0, 104.6, 6.02e-5, 0.204)});       // swimsuit
+
+  // Orthotropic (woven-cloth) variants; the isotropic presets above keep their names and values.
+  // Kawabata fabrics of Matsudaira et al. 2015 (B and areal density as above) with soft shear:
+  // G = 1.0 gf/cm/deg = 56.2 N/m assumed for all four, the middle of the 0.5–2 gf/cm/deg that
+  // KES-FB1 gives for woven cotton, wool and polyester (their G is not in that table).
+  p.push_back({"cotton_broadcloth_ortho", kawabata_orthotropic(1.157e-5, 0.1238, 1.0)});
+  p.push_back({"wool_tropical_ortho", kawabata_orthotropic(6.57e-6, 0.1629, 1.0)});
+  p.push_back({"polyester_tropical_ortho", kawabata_orthotropic(7.55e-6, 0.1165, 1.0)});
+  p.push_back({"polyester_faille_ortho", kawabata_orthotropic(1.86e-6, 0.1043, 1.0)});
+  // Wang, Ramamoorthi & O'Brien 2011, fitted by wang_orthotropic: the first row of "stretching"
+  // and the first column of the three "bending" rows (0°, 45°, 90°) of ARCSim's materials/*.json
+  // (the published data of that paper), areal density [kg/m²] from the same files.
+  p.push_back({"gray_interlock_ortho", wang_orthotropic(16.593832, -14.69599, 34.477123, 36.860302, 2.3191698e-05,
+                                                        2.4749964e-05, 1.4267624e-05, 0.187)});
+  p.push_back({"black_denim_ortho", wang_orthotropic(205.352005, 10.234077, 1013.88629, 53.387184, 6.4196457e-05,
+                                                     7.3384567e-05, 9.6951576e-05, 0.324)});
+  p.push_back({"royal_target_ortho", wang_orthotropic(2016.55456, 9.170511, 2034.97644, 104.759674, 1.25409805e-4,
+                                                      1.07997696e-4, 1.25409805e-4, 0.220)});
+  p.push_back({"ivory_rib_knit_ortho", wang_orthotropic(42.871021, -0.234556, 65.166023, 83.175644, 4.6237591e-05,
+                                                        3.001593e-05, 3.2243889e-05, 0.276)});
+  p.push_back({"camel_ponte_roma_ortho", wang_orthotropic(31.146198, -12.802702, 44.028667, 31.896357, 3.6348366e-05,
+                                                          3.3013252e-05, 3.7157593e-05, 0.284)});
+  p.push_back({"navy_sparkle_sweat_ortho", wang_orthotropic(12.486332, -19.875324, 3.272434, 17.616289, 5.9469658e-05,
+                                                            4.0072277e-05, 4.5625023e-05, 0.224)});
+  p.push_back({"pink_ribbon_brown_ortho", wang_orthotropic(151.503906, 106.02816, 244.830673, 30.250183, 1.17070122e-4,
+                                                           8.7509773e-05, 5.9774277e-05, 0.228)});
+  p.push_back({"tango_red_jet_set_ortho", wang_orthotropic(43.067627, 54.373299, 171.424835, 14.3147, 1.4293814e-05,
+                                                           2.19517e-05, 2.0345654e-05, 0.113)});
+  p.push_back({"white_dots_on_black_ortho", wang_orthotropic(2002.08618, 0.345588, 2027.48559, 19.189022, 5.1713814e-05,
+                                                             4.065947e-05, 3.1282822e-05, 0.128)});
+  p.push_back({"white_swim_solid_ortho", wang_orthotropic(47.971176, 6.834521, 104.615456, 60.773663, 6.0237942e-05,
+                                                          5.8803211e-05, 5.1018833e-05, 0.204)});
   return p;
 }
 
