@@ -398,6 +398,44 @@ TEST(OrthotropicStrips, CantileverDeflectionUsesTheRigidityAlongTheStrip) {
   }
 }
 
+// At 45° to the grain the strip also twists (the law couples bending and twist there); far from
+// the clamp, which holds the twist, the beam formula holds with the directional rigidity of
+// docs/materials.md §1, 1/B₄₅ = ¼ (1/B_w + 1/B_f + 1/D_t − 2ν/B_w). The curvature is measured on
+// the centre line between 40 % and 80 % of the length (w'' = M / (B₄₅ b), M = P (L − x)) from
+// second differences of the limit displacement.
+TEST(OrthotropicStrips, CantileverAt45DegreesBendsWithTheBiasRigidity) {
+  const double length = 0.2, width = 0.02, force = 1e-6;
+  Orthotropy o = woven();
+  o.poisson = 0.0;
+  const double bias = 1.0 / (0.25 * (1 / o.warp_bending + 1 / o.weft_bending + 1 / o.twist));
+  Problem p;
+  p.mesh = make_grid(length, width, 80, 8);
+  set_warp(p.mesh, Eigen::Vector3d(1, 1, 0).normalized());
+  set_orthotropy(p.material, o);
+  BoundaryCondition clamp;
+  clamp.vertices = select_vertices(p.mesh, [&](const auto& x) { return x(0) < -length / 2 + 1e-9; });
+  clamp.clamped = true;
+  p.boundary = {clamp};
+  const std::vector<int> tip = select_vertices(p.mesh, [&](const auto& x) { return x(0) > length / 2 - 1e-9; });
+  for (size_t i = 0; i < tip.size(); ++i) {
+    const double share = (i == 0 || i + 1 == tip.size()) ? 0.5 : 1.0;
+    p.point_loads.push_back({tip[i], Eigen::Vector3d(0, 0, -share * force / static_cast<double>(tip.size() - 1))});
+  }
+  const StaticResult r = solve_static(p);
+  auto w = [&](double x) { return r.limit_displacement(nearest_vertex(p.mesh, Eigen::Vector3d(x, 0, 0)), 2); };
+  const double h = length / 80;
+  double worst = 0.0;
+  for (double f : {0.4, 0.6, 0.8}) {
+    const double x = -length / 2 + f * length;
+    const double curvature = -(w(x + 4 * h) - 2 * w(x) + w(x - 4 * h)) / (16 * h * h);
+    const double expected = force * (length / 2 - x) / (bias * width);
+    std::printf("cantilever at 45 deg, x = %.2f L: curvature %.6e, beam %.6e, error %.3f%%\n", f, curvature, expected,
+                100 * (curvature / expected - 1));
+    worst = std::max(worst, std::abs(curvature / expected - 1));
+  }
+  EXPECT_LT(worst, 0.03);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Simply supported rectangular orthotropic plate under a uniform load q (docs/materials.md, Navier
 // series): w(x, y) = Σ_{m,n odd} 16 q sin(mπx/a) sin(nπy/b) /
