@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write a triangulated disc as an OBJ file (a mesh for Loop subdivision).
 
-Usage: make_disc_mesh.py [--radius R] [--rings N] OUT.obj
+Usage: make_disc_mesh.py [--radius R] [--rings N] [--uv] OUT.obj
 
 The disc lies in the x-z plane at y = 0, centred at the origin, with its
 triangles oriented so that the normal is +y. Ring k (k = 1..N) has 6*k vertices
@@ -11,7 +11,10 @@ rings are joined as in a hexagonal lattice (6 sectors of 2k-1 triangles), so
 every interior vertex has valence 6 and every boundary vertex valence 4, except
 the 6 boundary "corner" vertices of the sectors (valence 3).
 Counts: 1 + 3N(N+1) vertices, 6N^2 triangles. The output is deterministic
-(fixed formatting, no randomness).
+(fixed formatting, no randomness). With --uv every vertex also gets texture
+coordinates u = (x/R + 1)/2, v = (1 - z/R)/2 (a planar map: +u along +x, +v
+along -z), written as "vt" lines and "f a/a b/b c/c" faces, so that a woven
+material's grain can be measured from them (docs/materials.md, Grain: warp = +u).
 
 Example: make_disc_mesh.py --radius 0.15 --rings 20 scenes/meshes/cusick_disc_r015.obj
 """
@@ -60,11 +63,13 @@ def main(argv=None):
     ap = argparse.ArgumentParser(
         description="Write a triangulated disc (x-z plane, y = 0, normal +y) as OBJ: "
                     "concentric rings with 6k vertices on ring k, mostly valence-6 vertices.",
-        usage="%(prog)s [--radius R] [--rings N] OUT.obj")
+        usage="%(prog)s [--radius R] [--rings N] [--uv] OUT.obj")
     ap.add_argument("out", help="output OBJ path ('-' for stdout)")
     ap.add_argument("--radius", type=float, default=0.15, help="disc radius [m] (default 0.15)")
     ap.add_argument("--rings", type=int, default=20,
                     help="number of rings N (default 20: 1261 vertices, 2400 triangles)")
+    ap.add_argument("--uv", action="store_true",
+                    help="also write texture coordinates (planar: +u along +x, +v along -z)")
     a = ap.parse_args(argv)
     if not (a.radius > 0 and math.isfinite(a.radius)):
         ap.error("--radius must be a finite number > 0")
@@ -79,8 +84,14 @@ def main(argv=None):
         return "0.000000000" if s == "-0.000000000" else s
     for x, y, z in verts:
         lines.append("v %s %s %s" % (fmt(x), fmt(y), fmt(z)))
+    if a.uv:
+        for x, y, z in verts:
+            lines.append("vt %s %s" % (fmt((x / a.radius + 1) / 2), fmt((1 - z / a.radius) / 2)))
     for t in tris:
-        lines.append("f %d %d %d" % (t[0] + 1, t[1] + 1, t[2] + 1))
+        if a.uv:
+            lines.append("f %d/%d %d/%d %d/%d" % (t[0] + 1, t[0] + 1, t[1] + 1, t[1] + 1, t[2] + 1, t[2] + 1))
+        else:
+            lines.append("f %d %d %d" % (t[0] + 1, t[1] + 1, t[2] + 1))
     text = "\n".join(lines) + "\n"
     if a.out == "-":
         sys.stdout.write(text)
