@@ -87,8 +87,8 @@ LinearFeElastic::LinearFeElastic(const LinearFeDiscretization& d, bool corotatio
       if (!(w.norm() > 1e-6 * mesh.warp[t].norm()))
         throw std::invalid_argument("linear_fe: triangle " + std::to_string(t) +
                                     ": its warp direction is normal to it (or zero)");
-      const Eigen::Vector2d g = (frame.transpose() * w).normalized();
-      k_[t] = area[t] * b.transpose() * law_in_frame(material.membrane_law(), g(0), g(1)) * b;
+      const Eigen::Vector2d grain = (frame.transpose() * w).normalized();
+      k_[t] = area[t] * b.transpose() * law_in_frame(material.membrane_law(), grain(0), grain(1)) * b;
       continue;
     }
     k_[t] = area[t] * b.transpose() * c * b;

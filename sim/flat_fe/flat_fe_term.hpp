@@ -10,7 +10,11 @@
 // D = [X̂₁ − X̂₀, X̂₂ − X̂₀]); with d = Rᵀxᵢ − X̂ᵢ (in-plane, 2 per node)
 //     f = −R K_e d,   E = ½ dᵀ K_e d,   matrix R K_e Rᵀ (R frozen).
 // For the polar rotation and an isotropic C, −R K_e d is the exact gradient of E (the terms from
-// ∂R vanish because the stress commutes with S). `corotational` false: R is the rest frame, the
+// ∂R vanish because the stress commutes with S). An orthotropic material (docs/materials.md §4)
+// uses its plane-stress law turned into the triangle's rest frame about the triangle's warp
+// direction (TriMesh::warp) as C; −R K_e d is then the corotational force without the ∂R terms
+// (exact with the rotations frozen), and each hinge's B is the directional rigidity of bending
+// across its edge. `corotational` false: R is the rest frame, the
 // linear element (in-plane displacements only). Tension stiffening (the geometric stiffness of
 // the membrane stress) is not part of this method and is ignored.
 //

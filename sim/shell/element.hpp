@@ -5,7 +5,9 @@
 // rest positions X_I, the linearised membrane and bending strains in Voigt order
 // [ε₁₁, ε₂₂, 2ε₁₂] are α = Σ M_I u_I and β = Σ B_I u_I (local DOF order [x0 y0 z0 x1 y1 z1 ...]).
 // The element stiffness is K_e = Σ_q w_q j (K_m Mᵀ H M + D_b Bᵀ H B), with H the isotropic
-// material matrix in the curvilinear frame, K_m = E t/(1 − ν²), D_b = E t³/(12(1 − ν²)).
+// material matrix in the curvilinear frame, K_m = E t/(1 − ν²), D_b = E t³/(12(1 − ν²)); for an
+// orthotropic material K_m H and D_b H are replaced by the laws of docs/materials.md turned into
+// the curvilinear frame about the element's warp direction (curvilinear_matrix).
 #pragma once
 
 #include "sim/shell/material.hpp"

@@ -187,7 +187,7 @@ TEST(OrthotropicCorotatedShell, ForceAndMatrixMatchFiniteDifferencesWithFrozenRo
   bottom.vertices = select_box(sleeve.vertices, Eigen::Vector3d(-1, -1e-4, -1), Eigen::Vector3d(1, 1e-4, 1));
   cases.emplace_back("sleeve", std::make_unique<LoopShellDiscretization>(sleeve, std::vector<BoundaryCondition>{bottom}, m,
                                                                          Quadrature::one_point));
-  int checked = 0;
+  int checked = 0, with_tension = 0;
   for (const auto& [name, d] : cases)
     for (const testing::State& state :
          testing::states(*d, {.random_states = 2, .fold_degrees = 170.0, .fold_from = 0.0, .fold_name = "near-folded"})) {
@@ -200,8 +200,22 @@ TEST(OrthotropicCorotatedShell, ForceAndMatrixMatchFiniteDifferencesWithFrozenRo
       const testing::FdReport matrix = testing::check_matrix_against_force(shell, *d, state.x, eps);
       EXPECT_LT(matrix.relative(), 1e-6) << name << ", " << state.name << ": matrix vs force: " << matrix.describe();
       ++checked;
+      // The tension stiffening (with it minus without it) is the Jacobian of the tension force
+      // with the tensile membrane forces of the orthotropic law frozen.
+      CorotatedShell with(d->model(), true, true), without(d->model(), true, false);
+      const Eigen::MatrixXd k = testing::matrix_at(without, *d, state.x, {1.0, 0.0});
+      const Eigen::MatrixXd g = testing::matrix_at(with, *d, state.x, {1.0, 0.0}) - k;
+      if (g.cwiseAbs().maxCoeff() < 1e-12 * k.cwiseAbs().maxCoeff()) continue;  // no tension
+      ++with_tension;
+      const testing::FdReport t = testing::check_matrix_against_force(g, *d, state.x, eps, [&](const Eigen::VectorXd& y) {
+        Eigen::VectorXd u = y - d->rest();
+        d->make_consistent(u);
+        return with.elements().tension_force(u);
+      });
+      EXPECT_LT(t.relative(), 1e-6) << name << ", " << state.name << ": tension stiffening: " << t.describe();
     }
   EXPECT_GE(checked, 9);
+  EXPECT_GE(with_tension, 6);
 }
 
 // ---------------------------------------------------------------------------------------------
