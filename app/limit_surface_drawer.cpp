@@ -2,6 +2,9 @@
 
 #include "render/camera_math.hpp"
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -43,6 +46,29 @@ LimitSurfaceDrawer::LimitSurfaceDrawer(const Discretization& discretization, con
     edges_.push_back(static_cast<unsigned>(a));
     edges_.push_back(static_cast<unsigned>(b));
   }
+  // The grain lines: through each triangle's centroid along its warp (projected into its plane),
+  // 0.6 √(2 area) long.
+  const TriMesh& mesh = discretization.mesh();
+  if (settings.texture == "grain" && mesh.warp.size() == mesh.triangles.size()) {
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Triangle& tri = mesh.triangles[t];
+      const Eigen::Vector3d x0 = mesh.vertices.row(tri[0]), x1 = mesh.vertices.row(tri[1]), x2 = mesh.vertices.row(tri[2]);
+      Eigen::Matrix<double, 3, 2> e;
+      e << x1 - x0, x2 - x0;
+      const Eigen::Vector3d n = e.col(0).cross(e.col(1));
+      const Eigen::Vector3d w = mesh.warp[t] - mesh.warp[t].dot(n.normalized()) * n.normalized();
+      if (!(w.norm() > 0) || !(n.norm() > 0)) continue;
+      const double half = 0.3 * std::sqrt(n.norm());
+      const Eigen::Matrix2d gram = e.transpose() * e;
+      const Eigen::Vector2d centre(1.0 / 3, 1.0 / 3), step = gram.inverse() * (e.transpose() * (half * w.normalized()));
+      for (const Eigen::Vector2d& b : {Eigen::Vector2d(centre - step), Eigen::Vector2d(centre + step)}) {
+        grain_coefficients_.push_back(static_cast<double>(t));
+        grain_coefficients_.push_back(b(0));
+        grain_coefficients_.push_back(b(1));
+        grain_segments_.push_back(static_cast<unsigned>(grain_segments_.size()));
+      }
+    }
+  }
 }
 
 void LimitSurfaceDrawer::set_obstacles(const std::vector<Obstacle>& obstacles) {
@@ -78,6 +104,13 @@ SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::VectorXd& x, double t)
   if (settings_.wireframe) {
     s.control.resize(static_cast<std::size_t>(x.size()));
     for (Eigen::Index i = 0; i < x.size(); ++i) s.control[static_cast<std::size_t>(i)] = static_cast<float>(x(i));
+  }
+  const std::vector<Triangle>& triangles = discretization_.mesh().triangles;
+  for (std::size_t k = 0; k + 2 < grain_coefficients_.size(); k += 3) {
+    const Triangle& tri = triangles[static_cast<std::size_t>(grain_coefficients_[k])];
+    const Eigen::Vector3d x0 = x.segment<3>(3 * tri[0]), x1 = x.segment<3>(3 * tri[1]), x2 = x.segment<3>(3 * tri[2]);
+    const Eigen::Vector3d end = x0 + grain_coefficients_[k + 1] * (x1 - x0) + grain_coefficients_[k + 2] * (x2 - x0);
+    for (int c = 0; c < 3; ++c) s.grain.push_back(static_cast<float>(end(c)));
   }
   for (const Obstacle& o : obstacles_) {
     const Eigen::MatrixX3d v = mesh_at(o, t);
@@ -133,6 +166,13 @@ render::Frame LimitSurfaceDrawer::frame(const SurfaceSnapshot& s, const render::
     lines.positions = s.control;
     lines.segments = edges_;
     lines.color = {0.15f, 0.15f, 0.15f};
+    f.lines.push_back(std::move(lines));
+  }
+  if (!s.grain.empty()) {
+    render::Lines lines;
+    lines.positions = s.grain;
+    lines.segments = grain_segments_;
+    lines.color = {0.95f, 0.9f, 0.7f};  // a light thread colour over the cloth
     f.lines.push_back(std::move(lines));
   }
   if (!s.obstacles.empty()) {

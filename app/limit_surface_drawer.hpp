@@ -2,7 +2,8 @@
 // render::Frame data — the surface chosen by `render.surface` refined `render.refine` times
 // (positions and normals from the discretisation's operator for it, Discretization::drawn_display,
 // built once; by default the method's own surface), the control mesh as an optional wireframe, the
-// scene's colours and a camera (given, or framed once on a box: a whole sequence's bounds, or the
+// scene's colours, with render.texture "grain" a line along the warp across each control triangle,
+// and a camera (given, or framed once on a box: a whole sequence's bounds, or the
 // box known before a run, see app/frame_images.hpp).
 #pragma once
 
@@ -29,6 +30,7 @@ struct SurfaceSnapshot {
   std::vector<float> control;    // control mesh vertices (wireframe), 3 per vertex [m]
   std::vector<float> obstacles;  // the obstacles' mesh vertices at the frame's time, 3 per vertex [m]
   float plane_height = 0.0f;     // y of a horizontal plane obstacle at the frame's time [m]
+  std::vector<float> grain;      // render.texture "grain": two end points per control triangle [m]
 };
 
 class LimitSurfaceDrawer {
@@ -56,6 +58,11 @@ class LimitSurfaceDrawer {
   SurfaceOperator display_;
   std::vector<unsigned> triangles_;  // fine triangles
   std::vector<unsigned> edges_;      // edges of the mesh's triangles (wireframe over the nodes)
+  // render.texture "grain": per control triangle, the two end points of its rest warp line as
+  // coefficients (b₁, b₂) on its rest edges (P = X₀ + b₁ (X₁ − X₀) + b₂ (X₂ − X₀)), 4 per
+  // triangle; the line's end points move with the triangle's affine map. Empty without grain.
+  std::vector<double> grain_coefficients_;
+  std::vector<unsigned> grain_segments_;
   RenderSettings settings_;
   int width_, height_;
   std::vector<Obstacle> obstacles_;    // drawn meshes (no planes)

@@ -522,6 +522,7 @@ void check_vertex_count(const Reader& r, const std::string& path, const std::str
 struct GrainSpec {
   bool given = false;     // the key is present
   double warp_deg = 0.0;  // [deg], from the mesh's reference direction
+  std::string needed_by;  // the key that needs the grain when it is not given ("material", "render.texture")
 };
 
 // The grain of an OBJ mesh: from its texture coordinates, or an error naming what is missing
@@ -532,13 +533,14 @@ void obj_grain(const Reader& r, TriMesh& mesh, const GrainSpec& grain, bool need
     if (grain.given)
       r.fail("material.grain", "the mesh " + quote(file) +
                                    " has no texture coordinates (vt on every face) to measure the grain from");
-    r.fail("material", "an orthotropic material needs the grain direction, and the mesh " + quote(file) +
-                           " has no texture coordinates (vt on every face) to measure it from");
+    r.fail(grain.needed_by, std::string(grain.needed_by == "material" ? "an orthotropic material" : "\"grain\"") +
+                                " needs the grain direction, and the mesh " + quote(file) +
+                                " has no texture coordinates (vt on every face) to measure it from");
   }
   try {
     mesh.warp = uv_warp(mesh, grain.warp_deg);
   } catch (const std::exception& e) {
-    r.fail(grain.given ? "material.grain" : "material", quote(file) + ": " + e.what());
+    r.fail(grain.given ? "material.grain" : grain.needed_by, quote(file) + ": " + e.what());
   }
 }
 
@@ -1277,7 +1279,7 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   if (j == nullptr) return s;
   r.check_object(*j, "render",
                  {"width", "height", "refine", "color", "back_color", "background", "wireframe", "ground", "camera",
-                  "framing", "surface"});
+                  "framing", "surface", "texture"});
   if (const Json* v = r.find(*j, "width")) s.width = r.integer_at_least(*v, "render.width", 16);
   if (const Json* v = r.find(*j, "height")) s.height = r.integer_at_least(*v, "render.height", 16);
   if (s.width > 8192 || s.height > 8192) r.fail("render", "images larger than 8192 px are not supported");
@@ -1297,6 +1299,7 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   colour("back_color", s.back_color);
   colour("background", s.background);
   if (const Json* v = r.find(*j, "wireframe")) s.wireframe = r.boolean(*v, "render.wireframe");
+  if (const Json* v = r.find(*j, "texture")) s.texture = r.choice(*v, "render.texture", {"none", "grain"}, "texture");
   if (const Json* v = r.find(*j, "ground")) s.ground = r.boolean(*v, "render.ground");
   if (const Json* v = r.find(*j, "surface")) {
     const std::string surface = r.choice(*v, "render.surface", {"method", "loop_limit", "flat"}, "surface");
@@ -1548,8 +1551,10 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
                        max_vertices);
   }
   const Json& mesh_json = r.require(root, "", "mesh");
-  TriMesh mesh =
-      build_mesh(r, mesh_json, file.parent_path(), say, max_vertices, grain, grain.given || scene.problem.material.orthotropic());
+  const bool draw_grain = scene.render.texture == "grain";
+  grain.needed_by = scene.problem.material.orthotropic() ? "material" : "render.texture";
+  TriMesh mesh = build_mesh(r, mesh_json, file.parent_path(), say, max_vertices, grain,
+                            grain.given || scene.problem.material.orthotropic() || draw_grain);
   warn_about_cracks(mesh, mesh_json.contains("obj"), say);
   // An obstacle's translations too are measured against the cloth (the scene's scale).
   for (std::size_t i = 0; i < scene.problem.obstacles.size(); ++i)

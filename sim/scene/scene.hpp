@@ -51,6 +51,10 @@ struct RenderSettings {
   Eigen::Vector3d back_color{0.5, 0.1, 0.1};  // back faces
   Eigen::Vector3d background{1, 1, 1};
   bool wireframe = false;  // overlay the control mesh
+  // "render.texture": "none", or "grain": a short line along the (deformed) warp direction across
+  // every control triangle, so that a picture shows how the cloth is cut (the grain of
+  // material.grain, warp_deg 0 by default; an OBJ mesh needs texture coordinates for it).
+  std::string texture = "none";
   bool ground = false;     // a ground plane at the bottom of the framed box (see `framing`)
   bool has_camera = false;  // otherwise framed automatically, see `framing`
   Eigen::Vector3d eye{0, 0, 1}, target{0, 0, 0}, up{0, 1, 0};  // [m]

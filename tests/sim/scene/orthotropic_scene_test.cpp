@@ -216,6 +216,18 @@ TEST_F(OrthotropicScene, OrthotropicPresetsLoadAndTakeNumberOverrides) {
   EXPECT_TRUE(contains(e, expected("material.poisson_ratio: cannot be combined with an orthotropic membrane"))) << e;
 }
 
+TEST_F(OrthotropicScene, RenderTextureGrainLaysTheGrainEvenOnAnIsotropicMaterial) {
+  const Scene s = load(scene(R"("stretch_modulus": 5000, "grain": {"warp_deg": 90})", std::string(kGrid) + R"(, "render": {"texture": "grain"})"));
+  EXPECT_EQ(s.render.texture, "grain");
+  ASSERT_EQ(s.problem.mesh.warp.size(), s.problem.mesh.triangles.size());
+  for (const Eigen::Vector3d& w : s.problem.mesh.warp) EXPECT_LT((w - Eigen::Vector3d::UnitY()).norm(), 1e-15);
+  write("plain.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n");
+  std::string e = error(scene(R"("stretch_modulus": 5000)", R"("mesh": {"obj": "plain.obj"}, "render": {"texture": "grain"})"));
+  EXPECT_TRUE(contains(e, expected("render.texture: \"grain\" needs the grain direction"))) << e;
+  e = error(scene(R"("stretch_modulus": 5000)", std::string(kGrid) + R"(, "render": {"texture": "woven"})"));
+  EXPECT_TRUE(contains(e, expected("render.texture: unknown texture \"woven\""))) << e;
+}
+
 TEST(ObjTextureCoordinates, ReadWhenEveryCornerHasThem) {
   const TriMesh m = read_obj_text("v 0 0 0\nv 2 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n", "t.obj");
   ASSERT_EQ(m.uv.size(), 1u);

@@ -20,6 +20,7 @@ void expect_same(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.back_color, b.back_color);
   EXPECT_EQ(a.background, b.background);
   EXPECT_EQ(a.wireframe, b.wireframe);
+  EXPECT_EQ(a.texture, b.texture);
   EXPECT_EQ(a.ground, b.ground);
   EXPECT_EQ(a.has_camera, b.has_camera);
   EXPECT_EQ(a.eye, b.eye);
@@ -62,6 +63,7 @@ TEST(RenderSettingsJson, EveryKeyChangedRoundTrips) {
   s.back_color = {0, 0.25, 0.5};
   s.background = {0.9, 0.95, 1};
   s.wireframe = true;
+  s.texture = "grain";
   s.ground = true;
   s.has_camera = true;
   s.eye = {0.3, -0.3, 0.6};
