@@ -12,6 +12,7 @@
 #include "sim/static/static_solve.hpp"
 #include "sim/study/plates.hpp"
 #include "tests/support/fd_check.hpp"
+#include "tests/support/strips.hpp"
 #include "tests/support/term_states.hpp"
 #include "tests/support/test_meshes.hpp"
 
@@ -35,7 +36,7 @@ Orthotropy woven() {
   return o;
 }
 
-void set_warp(TriMesh& mesh, const Eigen::Vector3d& dir) { mesh.warp.assign(mesh.triangles.size(), dir); }
+using testing::set_warp;
 
 TEST(LinearFeOrthotropic, IsotropicLimitGivesTheIsotropicMatrix) {
   ShellMaterial iso;
@@ -93,27 +94,9 @@ TEST(LinearFeOrthotropic, StripElongationAlongWarpWeftAndBiasMatchesTheMembraneF
   const double length = 0.2, width = 0.04, force = 0.02;
   for (double deg : {0.0, 90.0, 45.0}) {
     const double angle = deg * M_PI / 180.0;
-    Problem p;
-    p.method = "linear_fe";
-    p.mesh = make_grid(length, width, 40, 8);
-    set_warp(p.mesh, Eigen::Vector3d(std::cos(angle), std::sin(angle), 0));
-    set_orthotropy(p.material, woven());
-    BoundaryCondition roller, pin, flat;
-    roller.vertices = select_vertices(p.mesh, [&](const auto& x) { return x(0) < -length / 2 + 1e-9; });
-    roller.fix = {true, false, false};
-    pin.vertices = {nearest_vertex(p.mesh, Eigen::Vector3d(-length / 2, 0, 0))};
-    pin.fix = {false, true, false};
-    flat.vertices = select_vertices(p.mesh, [](const auto&) { return true; });
-    flat.fix = {false, false, true};
-    p.boundary = {roller, pin, flat};
-    const std::vector<int> tip = select_vertices(p.mesh, [&](const auto& x) { return x(0) > length / 2 - 1e-9; });
-    for (size_t i = 0; i < tip.size(); ++i) {
-      const double share = (i == 0 || i + 1 == tip.size()) ? 0.5 : 1.0;
-      p.point_loads.push_back({tip[i], Eigen::Vector3d(share * force / static_cast<double>(tip.size() - 1), 0, 0)});
-    }
-    const StaticResult r = solve_static(p);
-    const int a = nearest_vertex(p.mesh, Eigen::Vector3d(-length / 4, 0, 0)), b = nearest_vertex(p.mesh, Eigen::Vector3d(length / 4, 0, 0));
-    const double strain = (r.limit_displacement(b, 0) - r.limit_displacement(a, 0)) / (r.limit_rest(b, 0) - r.limit_rest(a, 0));
+    ShellMaterial material;
+    set_orthotropy(material, woven());
+    const double strain = testing::pulled_strip_strain("linear_fe", material, angle, force, length, width);
     const double expected = force / width * directional_compliance(5000, 3000, 60, 0.25, angle);
     std::printf("linear_fe strip at %g deg to the warp: strain %.6e, formula %.6e, error %.3f%%\n", deg, strain, expected,
                 100 * (strain / expected - 1));

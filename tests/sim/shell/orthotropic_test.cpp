@@ -13,6 +13,7 @@
 #include "sim/static/static_solve.hpp"
 #include "sim/study/plates.hpp"
 #include "tests/support/fd_check.hpp"
+#include "tests/support/strips.hpp"
 #include "tests/support/term_states.hpp"
 #include "tests/support/test_meshes.hpp"
 
@@ -47,7 +48,7 @@ ShellMaterial woven_material() {
 }
 
 // Every triangle's warp along `dir`.
-void set_warp(TriMesh& mesh, const Eigen::Vector3d& dir) { mesh.warp.assign(mesh.triangles.size(), dir); }
+using testing::set_warp;
 
 // A random point of a curved surface: tangents of any length and angle.
 SurfacePoint random_point(std::mt19937& rng) {
@@ -339,31 +340,9 @@ double directional_compliance(double ew, double ef, double g, double nu, double 
   return std::pow(c, 4) / ew + std::pow(s, 4) / ef + (1.0 / g - 2.0 * nu / ew) * s * s * c * c;
 }
 
-// Strip L × b along x, warp at `angle` from +x towards +y; its left end held along x (and one
-// vertex along y), every vertex held in z (a membrane problem), an axial force P at the right end.
-// Returns the axial strain between x = −L/4 and x = L/4 on the centre line.
+// The strip of tests/support/strips.hpp with the Loop element (the default method).
 double strip_strain(double angle, double force, double length, double width) {
-  Problem p;
-  p.mesh = make_grid(length, width, 40, 8);
-  set_warp(p.mesh, Eigen::Vector3d(std::cos(angle), std::sin(angle), 0));
-  p.material = strip_material(0.25);
-  BoundaryCondition roller, pin, flat;
-  roller.vertices = select_vertices(p.mesh, [&](const auto& x) { return x(0) < -length / 2 + 1e-9; });
-  roller.fix = {true, false, false};
-  pin.vertices = {nearest_vertex(p.mesh, Eigen::Vector3d(-length / 2, 0, 0))};
-  pin.fix = {false, true, false};
-  flat.vertices = select_vertices(p.mesh, [](const auto&) { return true; });
-  flat.fix = {false, false, true};
-  p.boundary = {roller, pin, flat};
-  const std::vector<int> tip = select_vertices(p.mesh, [&](const auto& x) { return x(0) > length / 2 - 1e-9; });
-  for (size_t i = 0; i < tip.size(); ++i) {
-    const double share = (i == 0 || i + 1 == tip.size()) ? 0.5 : 1.0;
-    p.point_loads.push_back({tip[i], Eigen::Vector3d(share * force / static_cast<double>(tip.size() - 1), 0, 0)});
-  }
-  const StaticResult r = solve_static(p);
-  const int a = nearest_vertex(p.mesh, Eigen::Vector3d(-length / 4, 0, 0));
-  const int b = nearest_vertex(p.mesh, Eigen::Vector3d(length / 4, 0, 0));
-  return (r.limit_displacement(b, 0) - r.limit_displacement(a, 0)) / (r.limit_rest(b, 0) - r.limit_rest(a, 0));
+  return testing::pulled_strip_strain("", strip_material(0.25), angle, force, length, width);
 }
 
 TEST(OrthotropicStrips, ElongationAlongWarpWeftAndBiasMatchesTheMembraneFormula) {
