@@ -208,9 +208,11 @@ TEST(OrthotropicCorotatedShell, ForceAndMatrixMatchFiniteDifferencesWithFrozenRo
       const Eigen::MatrixXd g = testing::matrix_at(with, *d, state.x, {1.0, 0.0}) - k;
       if (g.cwiseAbs().maxCoeff() < 1e-12 * k.cwiseAbs().maxCoeff()) continue;  // no tension
       ++with_tension;
+      // (Through a plain pointer: clang does not let a lambda capture a structured binding.)
+      const LoopShellDiscretization* disc = d.get();
       const testing::FdReport t = testing::check_matrix_against_force(g, *d, state.x, eps, [&](const Eigen::VectorXd& y) {
-        Eigen::VectorXd u = y - d->rest();
-        d->make_consistent(u);
+        Eigen::VectorXd u = y - disc->rest();
+        disc->make_consistent(u);
         return with.elements().tension_force(u);
       });
       EXPECT_LT(t.relative(), 1e-6) << name << ", " << state.name << ": tension stiffening: " << t.describe();
