@@ -48,17 +48,7 @@ Eigen::Matrix3d curvilinear_matrix(const SurfacePoint& s, const Eigen::Vector3d&
   const Eigen::Vector3d dual1 = inv(0, 0) * s.a1 + inv(0, 1) * s.a2, dual2 = inv(1, 0) * s.a1 + inv(1, 1) * s.a2;
   Eigen::Matrix2d t;  // t(α, i) = a^α · g_i
   t << dual1.dot(g1), dual1.dot(g2), dual2.dot(g1), dual2.dot(g2);
-  // Row p = (α, β) of the Voigt pairs (11, 22, 12): the products t_αi t_βj summed over the pairs
-  // (i, j) of each Voigt index (both orders for the shear), so that H = T law Tᵀ.
-  Eigen::Matrix3d m;
-  const int first[3] = {0, 1, 0}, second[3] = {0, 1, 1};
-  for (int p = 0; p < 3; ++p) {
-    const int a = first[p], b = second[p];
-    m(p, 0) = t(a, 0) * t(b, 0);
-    m(p, 1) = t(a, 1) * t(b, 1);
-    m(p, 2) = t(a, 0) * t(b, 1) + t(a, 1) * t(b, 0);
-  }
-  return m * law * m.transpose();
+  return voigt_transform(t, law);
 }
 
 void material_matrices(const SurfacePoint& s, const ShellMaterial& material, const Eigen::Vector3d& warp,

@@ -29,6 +29,10 @@ Eigen::Matrix3d law_in_frame(const Eigen::Matrix3d& law, double c, double s) {
   // t(α, i) = e_α · g_i with g₁ = (c, s), g₂ = (−s, c) in the (e₁, e₂) frame.
   Eigen::Matrix2d t;
   t << c, -s, s, c;
+  return voigt_transform(t, law);
+}
+
+Eigen::Matrix3d voigt_transform(const Eigen::Matrix2d& t, const Eigen::Matrix3d& law) {
   Eigen::Matrix3d m;
   const int first[3] = {0, 1, 0}, second[3] = {0, 1, 1};
   for (int p = 0; p < 3; ++p) {

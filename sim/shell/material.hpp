@@ -43,6 +43,13 @@ Eigen::Matrix3d plane_stress_matrix(double e1, double e2, double shear, double n
 // engineering shear, H = T law Tᵀ with the tensor rotation T (docs/materials.md).
 Eigen::Matrix3d law_in_frame(const Eigen::Matrix3d& law, double c, double s);
 
+// `law` (Voigt (11, 22, 12), engineering shear, in the frame g₁, g₂) in the components of another
+// basis, given t(α, i) = e^α · g_i (e^α that basis's dual vectors, or an orthonormal frame's own):
+// H = T law Tᵀ with T's row (α, β) the products t_αi t_βj summed over the pairs (i, j) of each
+// Voigt index (both orders for the shear). Shared by law_in_frame and the element's curvilinear
+// components.
+Eigen::Matrix3d voigt_transform(const Eigen::Matrix2d& t, const Eigen::Matrix3d& law);
+
 // The uniaxial modulus of a plane-stress law (in the (g₁, g₂) frame) along the direction
 // c g₁ + s g₂: 1 / (the compliance's (1,1) entry rotated there), that is
 // 1/E_θ = c⁴/E₁ + s⁴/E₂ + (1/G − 2ν₁₂/E₁) s²c² for an orthotropic law. The same with the bending

@@ -1,10 +1,11 @@
-// Orthotropic test fixtures shared by the Loop element's and linear_fe's tests: a uniform warp on
-// every triangle, and a strip pulled along x whose axial strain is compared with the orthotropic
+// Orthotropic test fixtures shared by the Loop element's and linear_fe's tests: the woven
+// law, a uniform warp on every triangle, and a strip pulled along x whose axial strain is compared with the orthotropic
 // membrane formula (docs/materials.md).
 #pragma once
 
 #include "sim/mesh/generators.hpp"
 #include "sim/problem/problem.hpp"
+#include "sim/shell/material.hpp"
 #include "sim/static/static_solve.hpp"
 #include "sim/study/plates.hpp"
 
@@ -14,6 +15,20 @@
 #include <vector>
 
 namespace clothsim::testing {
+
+// The woven example (stiff along the yarns, soft in shear), its bending rigidities
+// scaled by `bending_scale`.
+inline Orthotropy woven_example(double bending_scale = 1.0) {
+  Orthotropy o;
+  o.warp_stretch = 5000;
+  o.weft_stretch = 3000;
+  o.shear_stretch = 60;
+  o.poisson = 0.25;
+  o.warp_bending = 1.2e-5 * bending_scale;
+  o.weft_bending = 0.9e-5 * bending_scale;
+  o.twist = 0.5e-5 * bending_scale;
+  return o;
+}
 
 // Every triangle's rest warp direction set to `dir`.
 inline void set_warp(TriMesh& mesh, const Eigen::Vector3d& dir) { mesh.warp.assign(mesh.triangles.size(), dir); }

@@ -24,17 +24,8 @@
 namespace clothsim {
 namespace {
 
-Orthotropy woven() {
-  Orthotropy o;
-  o.warp_stretch = 5000;
-  o.weft_stretch = 3000;
-  o.shear_stretch = 60;
-  o.poisson = 0.25;
-  o.warp_bending = 1.2e-4;
-  o.weft_bending = 0.9e-4;
-  o.twist = 0.5e-4;
-  return o;
-}
+// The woven example with ten times its bending rigidities.
+Orthotropy woven() { return testing::woven_example(10.0); }
 
 using testing::set_warp;
 

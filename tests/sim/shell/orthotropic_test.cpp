@@ -28,17 +28,7 @@ namespace clothsim {
 namespace {
 
 // The woven example: stiff along the yarns, soft in shear.
-Orthotropy woven() {
-  Orthotropy o;
-  o.warp_stretch = 5000;
-  o.weft_stretch = 3000;
-  o.shear_stretch = 60;
-  o.poisson = 0.25;
-  o.warp_bending = 1.2e-5;
-  o.weft_bending = 0.9e-5;
-  o.twist = 0.5e-5;
-  return o;
-}
+Orthotropy woven() { return testing::woven_example(); }
 
 ShellMaterial woven_material() {
   ShellMaterial m;
