@@ -1,6 +1,7 @@
 // Command-line entry point: `clothsim SCENE.json [--out DIR] [--end T]`. Argument parsing (CLI11)
 // lives in this file only; the work is done by run_scene_file (app/run.hpp).
 #include "app/compare.hpp"
+#include "app/fabric_test.hpp"
 #include "app/figures.hpp"
 #include "app/golden.hpp"
 #include "app/render_saved.hpp"
@@ -333,6 +334,72 @@ int figures_command(int argc, char** argv) {
   return clothsim::run_figures(options, sweep);
 }
 
+// `clothsim fabric-test PRESET|SCENE.json [--tests cantilever,bias,cusick] [--out DIR] ...`.
+int fabric_test_command(int argc, char** argv) {
+  CLI::App app{"clothsim fabric-test: the standard fabric tests run virtually on a material (a preset name, or\n"
+               "the \"material\" of a scene file): the cantilever bending test (ASTM D1388) along warp and\n"
+               "weft, tensile tests along warp, weft and the bias (45 deg) at small strain, and the Cusick\n"
+               "drape test (ISO 9073-9) on meshes of increasing refinement. Writes\n"
+               "DIR/fabric_test_<name>/fabric_test.md and .csv (each result beside the law's value and the\n"
+               "measured one where the preset's source has one), a picture per test and runs/; see\n"
+               "docs/fabric_test.md.",
+               "clothsim fabric-test"};
+  clothsim::FabricTestOptions options;
+  std::string out = options.out_root.string(), tests, rings;
+  app.add_option("material", options.target, "A material preset (e.g. cotton_broadcloth_ortho) or a scene file")
+      ->required()
+      ->type_name("PRESET|SCENE.json");
+  app.add_option("--tests", tests, "Comma-separated: cantilever, bias, cusick (default: all three)")->type_name("LIST");
+  app.add_option("--out", out, "Output root; the report goes to DIR/fabric_test_<name>/")
+      ->type_name("DIR")
+      ->capture_default_str();
+  app.add_option("--rings", rings, "Cusick meshes as disc ring counts, coarse to fine (default 16,24,32)")
+      ->type_name("N,N,...");
+  app.add_option("--end", options.cusick_end, "Cusick: simulated time [s]")->type_name("T")->capture_default_str();
+  app.add_flag("--quick", options.quick, "Coarse meshes and short runs (seconds; the numbers are not the test's)");
+  bool no_render = false;
+  app.add_flag("--no-render", no_render, "Write no pictures");
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
+  const auto split = [](const std::string& text) {
+    std::vector<std::string> parts;
+    std::string part;
+    for (const char c : text + ",") {
+      if (c == ',') {
+        if (!part.empty()) parts.push_back(part);
+        part.clear();
+      } else {
+        part += c;
+      }
+    }
+    return parts;
+  };
+  if (!tests.empty()) options.tests = split(tests);
+  if (options.quick) {
+    options.rings = {6, 8};
+    if (app.get_option("--end")->count() == 0) options.cusick_end = 0.2;
+  }
+  if (!rings.empty()) {
+    options.rings.clear();
+    for (const std::string& r : split(rings)) {
+      std::size_t used = 0;
+      int n = 0;
+      try {
+        n = std::stoi(r, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != r.size()) {
+        std::cerr << "clothsim: error: --rings: \"" << r << "\" is not a whole number\n";
+        return 1;
+      }
+      options.rings.push_back(n);
+    }
+  }
+  options.out_root = out;
+  options.render = !no_render;
+  return clothsim::run_fabric_test(options);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -346,6 +413,7 @@ int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "task") return task_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "compare") return compare_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "golden") return golden_command(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "fabric-test") return fabric_test_command(argc, argv);
   CLI::App app{
       "clothsim: Kirchhoff-Love thin-shell cloth simulator on Loop-subdivision surfaces.\n"
       "Runs the analysis described by SCENE (a JSON file, see scenes/README.md) and writes its\n"
@@ -359,7 +427,8 @@ int main(int argc, char** argv) {
       "  clothsim golden check|update MANIFEST       check or rewrite golden images of scenes\n"
       "  clothsim study convergence|stability|folds  write a report of README.md, \"Studies\"\n"
       "  clothsim figures [N ...]                    the paper's Figs. 1, 7-11 (docs/figures.md)\n"
-      "  clothsim task DIR ID                        one task of a planned study (docs/cluster.md)\n",
+      "  clothsim task DIR ID                        one task of a planned study (docs/cluster.md)\n"
+      "  clothsim fabric-test PRESET|SCENE.json      standard fabric tests, virtually (docs/fabric_test.md)\n",
       "clothsim"};
   std::string scene;
   std::string out = "out";

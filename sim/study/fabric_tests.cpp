@@ -130,7 +130,7 @@ Json cantilever_scene(const FabricUnderTest& fabric, double angle_deg, double ov
       {"probes", {{{"name", "tip"}, {"at", {overhang, 0, 0}}}}},
       {"render",
        {{"background", {1, 1, 1}},
-        {"camera", {{"eye", {overhang * 0.5, -overhang * 0.35, overhang * 2.6}}, {"target", {overhang * 0.35, -overhang * 0.3, 0}}}}}},
+        {"camera", {{"eye", {overhang * 1.2, overhang * 0.6, overhang * 2.4}}, {"target", {overhang * 0.4, -overhang * 0.35, 0}}}}}},
   };
   if (!apparatus_obj.empty()) {
     scene["collision"] = Json{{"self", false}, {"thickness", 0.0005}, {"friction", 0.3}};
@@ -309,7 +309,7 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
       {"mesh", {{"obj", disc_file}, {"translate", {0, h, 0}}}},
       {"material", with_grain(fabric, 0.0)},
       {"loads", {{"gravity", {0, -kGravity, 0}}}},
-      {"time", {{"dt", s.dt}, {"end", s.end}, {"output_fps", 2.0}}},
+      {"time", {{"dt", s.dt}, {"end", s.end}, {"output_fps", 4.0 / s.end}}},  // frames at every quarter
       {"damping", {{"stiffness", 0.001}, {"mass", 1.0}}},
       {"collision", {{"self", true}, {"thickness", s.thickness}, {"friction", 0.3}}},
       {"obstacles",
@@ -321,7 +321,8 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
          {"radius", s.support_radius},
          {"friction", 0.4}}}},
       {"output", {{"obj", true}, {"obj_level", 2}}},
-      {"render", {{"background", {1, 1, 1}}, {"camera", {{"eye", {0.0, h + 0.45, 0.001}}, {"target", {0, h, 0}}}}}},
+      {"render",
+       {{"background", {1, 1, 1}}, {"texture", "grain"}, {"camera", {{"eye", {0.0, h + 0.5, 0.001}}, {"target", {0, h - 0.05, 0}}}}}},
   };
   if (s.imperfection > 0) scene["imperfection"] = Json{{"amplitude", s.imperfection}, {"seed", 1}};
   return scene;

@@ -1,0 +1,28 @@
+// `clothsim fabric-test PRESET|SCENE.json [--tests cantilever,bias,cusick] [--out DIR]`: the
+// standard fabric tests run virtually on a material (sim/study/fabric_tests.hpp,
+// docs/fabric_test.md). Writes DIR/fabric_test_<name>/ whole or not at all: fabric_test.md (the
+// table, beside each result the law's value and the measured one where the preset's source has
+// one), fabric_test.csv, a picture per test and runs/ (the scenes and run folders behind them).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace clothsim {
+
+struct FabricTestOptions {
+  std::string target;                             // a preset name or a scene file (.json)
+  std::vector<std::string> tests = {"cantilever", "bias", "cusick"};
+  std::filesystem::path out_root = "out";
+  std::vector<int> rings = {16, 24, 32};          // Cusick meshes, coarse to fine
+  double cusick_end = 3.0;                        // [s]
+  bool quick = false;                             // coarse and short (seconds; for tests)
+  bool render = true;
+};
+
+// Returns the exit code: 0, or 1 with "clothsim: error: ..." on stderr (bad options, a material
+// that cannot be read, a run that fails) and no folder written.
+int run_fabric_test(const FabricTestOptions& options);
+
+}  // namespace clothsim
