@@ -62,11 +62,12 @@ DrapeMeasure measure_drape(const Eigen::MatrixX3d& vertices, const std::vector<s
   }
   const double h = s.cell;
   const double x0 = p.col(0).minCoeff() - 2 * h, y0 = p.col(1).minCoeff() - 2 * h;
-  const long long nx = static_cast<long long>(std::ceil((p.col(0).maxCoeff() - x0) / h)) + 2;
-  const long long ny = static_cast<long long>(std::ceil((p.col(1).maxCoeff() - y0) / h)) + 2;
-  if (nx * ny > 100000000LL)
-    throw std::invalid_argument("measure_drape: the shadow needs " + std::to_string(nx * ny) +
+  // The cell counts, checked as doubles before they become integers.
+  const double cells_x = std::ceil((p.col(0).maxCoeff() - x0) / h) + 2, cells_y = std::ceil((p.col(1).maxCoeff() - y0) / h) + 2;
+  if (!(cells_x * cells_y <= 1e8))
+    throw std::invalid_argument("measure_drape: the shadow needs " + std::to_string(cells_x * cells_y) +
                                 " raster cells (more than 1e8): use a larger cell");
+  const long long nx = static_cast<long long>(cells_x), ny = static_cast<long long>(cells_y);
   std::vector<std::uint8_t> grid(static_cast<size_t>(nx * ny), 0);
   // A cell is in the shadow when its centre lies in (or on) a projected triangle.
   for (const auto& t : triangles) {
