@@ -5,6 +5,7 @@
 #include "app/run.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/study/fabric_tests.hpp"
+#include "sim/study/report_format.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -24,16 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
-std::string sci(double v) {
-  std::ostringstream s;
-  s << std::setprecision(4) << v;
-  return s.str();
-}
+std::string fixed(double v, int digits) { return format_fixed(v, digits); }
+std::string sci(double v) { return format_significant(v, 4); }
 std::string percent(double value, double reference) { return fixed(100.0 * (value / reference - 1.0), 2); }
 
 void say(const std::string& line) { std::cerr << "clothsim: fabric-test: " << line << '\n'; }
@@ -104,6 +97,8 @@ void cantilever_part(const FabricUnderTest& f, const FabricTestOptions& o, const
          << "rigidity of a strip cut along that direction.\n\n"
          << "| strip along | runs | overhang L [mm] | c [mm] | expected c [mm] | c − expected | G [N·m] | B_θ of the law [N·m] | measured B [N·m] | tip speed at rest [mm/s] |\n"
          << "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|\n";
+  // The platform and the incline, an obstacle of the picture runs (the strip 1 mm above the platform).
+  write_text_file(dir / "runs" / "apparatus.obj", cantilever_apparatus_obj(s.incline_deg, 0.001, s.width));
   for (const auto& [name, angle] : std::vector<std::pair<std::string, double>>{{"warp", 0.0}, {"weft", 90.0}}) {
     const CantileverResult r = cantilever_test(f, angle, s, say);
     const double law_b = strip_bending_rigidity(f.law, angle);
@@ -117,11 +112,9 @@ void cantilever_part(const FabricUnderTest& f, const FabricTestOptions& o, const
            << " | " << (measured_b ? sci(*measured_b) : std::string("–")) << " | "
            << fixed(r.runs.back().tip_speed * 1000, 3) << " |\n";
     // The picture: the strip at the found overhang over the platform and the incline (obstacles).
-    const fs::path runs = dir / "runs";
-    write_text_file(runs / "apparatus.obj", cantilever_apparatus_obj(s.incline_deg, 0.001, s.width));
     Json scene = cantilever_scene(f, angle, r.overhang, s, "apparatus.obj");
     scene["name"] = "cantilever_" + name;
-    keep_picture(run_scene(scene, runs, o), dir / ("cantilever_" + name + ".png"));
+    keep_picture(run_scene(scene, dir / "runs", o), dir / ("cantilever_" + name + ".png"));
   }
   rep.md << "\n![cantilever along the warp](cantilever_warp.png) ![cantilever along the weft](cantilever_weft.png)\n\n";
 }
@@ -237,10 +230,11 @@ void cusick_part(const FabricUnderTest& f, const FabricTestOptions& o, const fs:
 
 std::string csv_of(const Report& rep) {
   std::ostringstream c;
-  c << std::setprecision(9) << "test,direction_deg,quantity,unit,virtual,law,measured\n";
+  c << "test,direction_deg,quantity,unit,virtual,law,measured\n";
   for (const Row& r : rep.rows)
-    c << r.test << ',' << r.direction << ',' << r.quantity << ',' << r.unit << ',' << r.value << ','
-      << (r.law ? sci(*r.law) : std::string()) << ',' << (r.measured ? sci(*r.measured) : std::string()) << '\n';
+    c << r.test << ',' << format_shortest(r.direction) << ',' << r.quantity << ',' << r.unit << ','
+      << format_shortest(r.value) << ',' << (r.law ? format_shortest(*r.law) : std::string()) << ','
+      << (r.measured ? format_shortest(*r.measured) : std::string()) << '\n';
   return c.str();
 }
 
