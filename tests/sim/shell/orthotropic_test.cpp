@@ -349,12 +349,13 @@ TEST(OrthotropicStrips, ElongationAlongWarpWeftAndBiasMatchesTheMembraneFormula)
   }
 }
 
-// Cantilever strip (ν = 0: plate bending along the strip is beam bending), clamped at x = −L/2,
-// tip force P: tip deflection P L³ / (3 B b) with B the rigidity along the strip.
-double cantilever_tip(double angle, const Orthotropy& o, double force, double length, double width) {
+// A strip [−L/2, L/2] × [−W/2, W/2] (nx × ny cells) of law `o` with its warp along `warp`,
+// clamped at x = −L/2, with the force P (along −z) spread evenly over the tip's vertices.
+Problem cantilever_problem(const Orthotropy& o, const Eigen::Vector3d& warp, double force, double length, double width,
+                           int nx, int ny) {
   Problem p;
-  p.mesh = make_grid(length, width, 40, 4);
-  set_warp(p.mesh, Eigen::Vector3d(std::cos(angle), std::sin(angle), 0));
+  p.mesh = make_grid(length, width, nx, ny);
+  set_warp(p.mesh, warp);
   set_orthotropy(p.material, o);
   BoundaryCondition clamp;
   clamp.vertices = select_vertices(p.mesh, [&](const auto& x) { return x(0) < -length / 2 + 1e-9; });
@@ -362,9 +363,16 @@ double cantilever_tip(double angle, const Orthotropy& o, double force, double le
   p.boundary = {clamp};
   const std::vector<int> tip = select_vertices(p.mesh, [&](const auto& x) { return x(0) > length / 2 - 1e-9; });
   for (size_t i = 0; i < tip.size(); ++i) {
-    const double share = (i == 0 || i + 1 == tip.size()) ? 0.125 : 0.25;
-    p.point_loads.push_back({tip[i], Eigen::Vector3d(0, 0, -share * force)});
+    const double share = (i == 0 || i + 1 == tip.size()) ? 0.5 : 1.0;
+    p.point_loads.push_back({tip[i], Eigen::Vector3d(0, 0, -share * force / static_cast<double>(tip.size() - 1))});
   }
+  return p;
+}
+
+// Cantilever strip (ν = 0: plate bending along the strip is beam bending), 40 × 4 cells, tip force
+// P: tip deflection P L³ / (3 B b) with B the rigidity along the strip.
+double cantilever_tip(double angle, const Orthotropy& o, double force, double length, double width) {
+  const Problem p = cantilever_problem(o, Eigen::Vector3d(std::cos(angle), std::sin(angle), 0), force, length, width, 40, 4);
   const StaticResult r = solve_static(p);
   return -r.limit_displacement(nearest_vertex(p.mesh, Eigen::Vector3d(length / 2, 0, 0)), 2);
 }
@@ -393,19 +401,7 @@ TEST(OrthotropicStrips, CantileverAt45DegreesBendsWithTheBiasRigidity) {
   Orthotropy o = woven();
   o.poisson = 0.0;
   const double bias = 1.0 / (0.25 * (1 / o.warp_bending + 1 / o.weft_bending + 1 / o.twist));
-  Problem p;
-  p.mesh = make_grid(length, width, 80, 8);
-  set_warp(p.mesh, Eigen::Vector3d(1, 1, 0).normalized());
-  set_orthotropy(p.material, o);
-  BoundaryCondition clamp;
-  clamp.vertices = select_vertices(p.mesh, [&](const auto& x) { return x(0) < -length / 2 + 1e-9; });
-  clamp.clamped = true;
-  p.boundary = {clamp};
-  const std::vector<int> tip = select_vertices(p.mesh, [&](const auto& x) { return x(0) > length / 2 - 1e-9; });
-  for (size_t i = 0; i < tip.size(); ++i) {
-    const double share = (i == 0 || i + 1 == tip.size()) ? 0.5 : 1.0;
-    p.point_loads.push_back({tip[i], Eigen::Vector3d(0, 0, -share * force / static_cast<double>(tip.size() - 1))});
-  }
+  const Problem p = cantilever_problem(o, Eigen::Vector3d(1, 1, 0).normalized(), force, length, width, 80, 8);
   const StaticResult r = solve_static(p);
   auto w = [&](double x) { return r.limit_displacement(nearest_vertex(p.mesh, Eigen::Vector3d(x, 0, 0)), 2); };
   const double h = length / 80;
