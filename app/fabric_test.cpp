@@ -157,6 +157,7 @@ void cusick_part(const FabricUnderTest& f, const FabricTestOptions& o, const fs:
   CusickSettings s;
   s.rings = o.rings;
   s.end = o.cusick_end;
+  s.imperfection = o.imperfection;
   const fs::path runs = dir / "runs";
   struct Level {
     int rings = 0, vertices = 0;
@@ -201,8 +202,9 @@ void cusick_part(const FabricUnderTest& f, const FabricTestOptions& o, const fs:
   rep.md << "## Cusick drape (ISO 9073-9)\n\n"
          << "A disc of " << fixed(2 * s.specimen_radius * 100, 0) << " cm on a support disc of "
          << fixed(2 * s.support_radius * 100, 0) << " cm, " << fixed(s.end, 2) << " s under gravity (dt " << s.dt
-         << " s, self-collision, contact thickness " << s.thickness * 1000 << " mm), on meshes of increasing "
-         << "refinement. DC = (A_shadow − A_support) / (A_specimen − A_support) from the vertical projection of the "
+         << " s, self-collision, contact thickness " << s.thickness * 1000 << " mm"
+         << (s.imperfection > 0 ? ", seeded imperfection " + fixed(s.imperfection * 1000, 2) + " mm" : std::string())
+         << "), on meshes of increasing refinement. DC = (A_shadow − A_support) / (A_specimen − A_support) from the vertical projection of the "
          << "drawn surface (the limit surface refined twice; raster cell 0.5 mm); nodes: maxima of the shadow's outline "
          << "radius standing out by at least 5 mm. Rest: the largest vertex speed over the last quarter of the run.\n\n"
          << "| rings | vertices | DC | ± raster | nodes | change of DC from the previous mesh | largest speed at the end [mm/s] | wall [s] |\n"
@@ -250,6 +252,8 @@ int run_fabric_test(const FabricTestOptions& o) {
       if (o.rings[i] < 2 || o.rings[i] > 200 || (i > 0 && o.rings[i] <= o.rings[i - 1]))
         throw std::invalid_argument("--rings: expected increasing ring counts between 2 and 200");
     if (!(o.cusick_end > 0) || o.cusick_end > 60) throw std::invalid_argument("--end: expected 0 < T <= 60 s");
+    if (!(o.imperfection >= 0) || o.imperfection > 0.01)
+      throw std::invalid_argument("--imperfection: expected 0 <= A <= 0.01 m");
     const FabricUnderTest f = fabric_under_test(o.target);
     const fs::path target = output_folder_path(o.out_root / ("fabric_test_" + f.label), "--out");
     const auto t0 = std::chrono::steady_clock::now();

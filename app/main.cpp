@@ -356,6 +356,10 @@ int fabric_test_command(int argc, char** argv) {
   app.add_option("--rings", rings, "Cusick meshes as disc ring counts, coarse to fine (default 16,24,32)")
       ->type_name("N,N,...");
   app.add_option("--end", options.cusick_end, "Cusick: simulated time [s]")->type_name("T")->capture_default_str();
+  app.add_option("--imperfection", options.imperfection,
+                 "Cusick: a seeded imperfection of the specimen, largest normal offset A [m] (scene key imperfection)")
+      ->type_name("A")
+      ->capture_default_str();
   app.add_flag("--quick", options.quick, "Coarse meshes and short runs (seconds; the numbers are not the test's)");
   bool no_render = false;
   app.add_flag("--no-render", no_render, "Write no pictures");

@@ -133,7 +133,7 @@ struct CusickSettings {
   double end = 3.0;            // simulated time [s]
   double dt = 0.002;           // [s]
   double thickness = 0.001;    // contact thickness [m]
-  double imperfection = 0.0;   // none by default
+  double imperfection = 0.0;   // [m] a seeded imperfection of the specimen (scene key imperfection, seed 1); 0: none
 };
 // The specimen: a disc of `rings` rings (1 + 3N(N+1) vertices, ring k of 6k), in the x–z plane
 // with normal +y, texture coordinates u = (x/R + 1)/2, v = (1 − z/R)/2 (warp along +x).
