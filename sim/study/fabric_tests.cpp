@@ -306,7 +306,9 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
       {"description", "Cusick drape test (ISO 9073-9): the specimen disc lies centred on the support disc and drapes "
                       "under gravity"},
       {"analysis", "dynamic"},
-      {"mesh", {{"obj", disc_file}, {"translate", {0, h, 0}}}},
+      // An imperfection moves points by up to its amplitude either way: the disc is raised by it so
+      // that it starts clear of the support.
+      {"mesh", {{"obj", disc_file}, {"translate", {0, h + s.imperfection, 0}}}},
       {"material", with_grain(fabric, 0.0)},
       {"loads", {{"gravity", {0, -kGravity, 0}}}},
       {"time", {{"dt", s.dt}, {"end", s.end}, {"output_fps", 4.0 / s.end}}},  // frames at every quarter

@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 namespace clothsim {
 namespace {
@@ -90,6 +92,28 @@ TEST(FabricTest, DiscSpecimenMesh) {
   }
   // The outer ring is a polygon of 6N corners on the circle: area (6N/2) R² sin(2π/6N).
   EXPECT_NEAR(area, 3 * rings * 0.15 * 0.15 * std::sin(2 * kPi / (6 * rings)), 1e-12);
+}
+
+TEST(FabricTest, CusickSpecimenStartsClearOfTheSupport) {
+  // With and without a seeded imperfection, every control vertex starts at least the contact
+  // thickness above the support's top (an imperfection of 2 mm on a 1 mm gap once started the
+  // specimen inside the support).
+  const FabricUnderTest f = fabric_under_test("polyester_faille_ortho");
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "clothsim_cusick_scene_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "disc.obj") << disc_obj(0.15, 8);
+  for (const double a : {0.0, 0.002, 0.005}) {
+    CusickSettings s;
+    s.imperfection = a;
+    const Scene scene = load_scene_text(cusick_scene(f, "disc.obj", s).dump(), dir / "cusick.json", {});
+    const double top = s.height - s.thickness;  // the support's top
+    double lowest = 1e9;
+    for (Eigen::Index i = 0; i < scene.problem.mesh.vertices.rows(); ++i)
+      if (std::hypot(scene.problem.mesh.vertices(i, 0), scene.problem.mesh.vertices(i, 2)) <= s.support_radius)
+        lowest = std::min(lowest, scene.problem.mesh.vertices(i, 1));
+    EXPECT_GE(lowest - top, s.thickness - 1e-12) << a;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 TEST(FabricTest, MaterialFromPresetAndMeasurements) {
