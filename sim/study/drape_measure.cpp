@@ -1,5 +1,7 @@
 #include "sim/study/drape_measure.hpp"
 
+#include "sim/study/fold_count.hpp"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -9,37 +11,6 @@
 #include <string>
 
 namespace clothsim {
-
-std::vector<int> prominent_maxima(const std::vector<double>& r, double prominence) {
-  const int n = static_cast<int>(r.size());
-  std::vector<int> found;
-  if (n < 3) return found;
-  const double lowest = *std::min_element(r.begin(), r.end());
-  for (int k = 0; k < n; ++k) {
-    // A maximum: above its predecessor, not below its successor (a plateau counts at its start).
-    const double v = r[k];
-    if (!(v > r[(k + n - 1) % n] && v >= r[(k + 1) % n])) continue;
-    // In each direction, the lowest value met before a higher one (or the same value at an earlier
-    // index, so that equal peaks are told apart); none when no such value is met.
-    double key_col = -1e300;
-    bool highest = true;
-    for (const int step : {1, -1}) {
-      double low = v;
-      for (int d = 1; d < n; ++d) {
-        const int q = ((k + step * d) % n + n) % n;
-        if (r[q] > v || (r[q] == v && q < k)) {
-          key_col = std::max(key_col, low);
-          highest = false;
-          break;
-        }
-        low = std::min(low, r[q]);
-      }
-    }
-    const double stands_out = highest ? v - lowest : v - key_col;
-    if (stands_out >= prominence) found.push_back(k);
-  }
-  return found;
-}
 
 DrapeMeasure measure_drape(const Eigen::MatrixX3d& vertices, const std::vector<std::array<int, 3>>& triangles,
                            const DrapeMeasureSettings& s) {
@@ -133,7 +104,9 @@ DrapeMeasure measure_drape(const Eigen::MatrixX3d& vertices, const std::vector<s
     for (int d = -half; d < w - half; ++d) sum += r[static_cast<size_t>(((k + d) % n + n) % n)];
     m.outline[static_cast<size_t>(k)] = sum / w;
   }
-  m.node_bins = prominent_maxima(m.outline, s.prominence);
+  // The nodes: the outline's maxima by topographic prominence, as the sleeves' folds are counted.
+  for (const SignalPeak& peak : find_profile_peaks(m.outline, true))
+    if (peak.prominence >= s.prominence) m.node_bins.push_back(peak.index);
   m.nodes = static_cast<int>(m.node_bins.size());
   return m;
 }

@@ -28,7 +28,7 @@ struct DrapeMeasure {
   double drape_coefficient = 0.0;  // DC [-]
   int nodes = 0;                   // outline maxima with at least the prominence
   std::vector<double> outline;     // smoothed outline radius per angular bin [m], about the shadow's centroid
-  std::vector<int> node_bins;      // the bins of the counted maxima
+  std::vector<int> node_bins;      // the bins of the counted maxima (find_profile_peaks, sim/study/fold_count.hpp)
 };
 
 // Measures the surface (vertices #V × 3 [m], triangles). Throws std::invalid_argument for an
@@ -36,11 +36,5 @@ struct DrapeMeasure {
 // for the raster (more than 10^8 cells).
 DrapeMeasure measure_drape(const Eigen::MatrixX3d& vertices, const std::vector<std::array<int, 3>>& triangles,
                            const DrapeMeasureSettings& settings = {});
-
-// The maxima of a circular sequence whose topographic prominence is at least `prominence`: a
-// maximum's prominence is its height above the higher of the two lowest points met on the way, in
-// each direction, to a higher value (the highest maximum: above the sequence's minimum). Plateaus
-// count once. Returns their indices in ascending order.
-std::vector<int> prominent_maxima(const std::vector<double>& r, double prominence);
 
 }  // namespace clothsim

@@ -54,6 +54,15 @@ TEST(FabricTestCli, SceneFileMaterialAndOneTest) {
   EXPECT_NE(csv.find("tensile,45,stretch_modulus"), std::string::npos);
   EXPECT_NE(csv.find("bias,45,shear_modulus,N/m,"), std::string::npos);
   EXPECT_EQ(csv.find("cantilever"), std::string::npos);
+  // Three Cusick meshes: DC extrapolated to zero element size as well.
+  ASSERT_EQ(run_shell(shell_quote(kClothsim) + " fabric-test " + shell_quote((tmp / "woven.json").string()) +
+                      " --tests cusick --quick --rings 5,6,7 --no-render --out " + shell_quote((tmp / "c").string()) +
+                      " 2>/dev/null >/dev/null"),
+            0);
+  const std::string cusick = read_file_bytes(tmp / "c" / "fabric_test_woven" / "fabric_test.csv");
+  EXPECT_NE(cusick.find("cusick,0,drape_coefficient_extrapolated,-,"), std::string::npos) << cusick;
+  EXPECT_NE(read_file_bytes(tmp / "c" / "fabric_test_woven" / "fabric_test.md").find("Extrapolated to zero element size"),
+            std::string::npos);
   EXPECT_FALSE(fs::exists(tmp / "fabric_test_woven" / "tensile_bias.png"));  // --no-render
   fs::remove_all(tmp);
 }

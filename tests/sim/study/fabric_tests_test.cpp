@@ -57,13 +57,21 @@ TEST(DrapeMeasure, LobedShadowAreaAndNodes) {
   }
 }
 
-TEST(DrapeMeasure, ProminenceIgnoresRipples) {
-  // Three clear peaks with ripples of 1 mm on the slopes (prominence 5 mm).
-  std::vector<double> r(360);
-  for (int i = 0; i < 360; ++i) r[i] = 0.1 + 0.02 * std::cos(3 * i * kPi / 180) + 0.001 * std::cos(40 * i * kPi / 180);
-  EXPECT_EQ(prominent_maxima(r, 0.005).size(), 3u);
-  EXPECT_GT(prominent_maxima(r, 0.0).size(), 3u);
-  EXPECT_TRUE(prominent_maxima(std::vector<double>(50, 1.0), 0.0).empty());  // a flat outline: no maximum
+TEST(DrapeMeasure, RipplesOnTheOutlineAreNotNodes) {
+  // Three lobes of 18 mm with ripples of 0.6 mm (40 around) on the outline: 3 nodes at the
+  // default prominence of 5 mm, more with none.
+  Eigen::MatrixX3d v(4001, 3);
+  std::vector<std::array<int, 3>> f;
+  v.row(0).setZero();
+  for (int i = 0; i < 4000; ++i) {
+    const double t = 2 * kPi * i / 4000, r = 0.12 * (1 + 0.15 * std::cos(3 * t) + 0.005 * std::cos(40 * t));
+    v.row(i + 1) << r * std::cos(t), 0.0, -r * std::sin(t);
+    f.push_back({0, i + 1, (i + 1) % 4000 + 1});
+  }
+  EXPECT_EQ(measure_drape(v, f).nodes, 3);
+  DrapeMeasureSettings s;
+  s.prominence = 0;
+  EXPECT_GT(measure_drape(v, f, s).nodes, 3);
 }
 
 TEST(DrapeMeasure, BadInputIsRefused) {
