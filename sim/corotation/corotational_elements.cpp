@@ -151,6 +151,7 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
   for (const ShellElement& el : elements)
     if (static_cast<int>(el.basis.size()) != points_per_element_) throw std::logic_error("elements with different quadrature rules");
   rest_patch_.resize(patch_offset_[count]);
+  base_patch_.resize(patch_offset_[count]);
   x_patch_.resize(patch_offset_[count]);
   local_force_.resize(patch_offset_[count]);
   tangent_rows_.resize(2 * static_cast<size_t>(patch_offset_[count] / 3));
@@ -191,14 +192,15 @@ CorotationalElements::CorotationalElements(const ShellModel& model, bool corotat
               for (Eigen::Index i = 0; i < 3; ++i) packed[e].push_back(k(3 * a + i, 3 * b + j));
       }
       const Eigen::Index np = static_cast<Eigen::Index>(el.patch.size());
-      for (Eigen::Index p = 0; p < np; ++p)
-        rest_patch_.segment<3>(patch_offset_[e] + 3 * p) = rest.row(el.patch[p]).transpose();
+      for (Eigen::Index p = 0; p < np; ++p) {
+        base_patch_.segment<3>(patch_offset_[e] + 3 * p) = rest.row(el.patch[p]).transpose();
+        rest_patch_.segment<3>(patch_offset_[e] + 3 * p) = el.reference.row(p).transpose();
+      }
       // Tangent rows at the barycentre (the paper's choice for the element rotation).
       const PatchEvaluation centre = evaluate_patch(model.extended().topology, el.triangle, 1.0 / 3, 1.0 / 3);
       Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic>>(tangent_rows_.data() + 2 * (patch_offset_[e] / 3), 2, np) =
           centre.basis.middleRows(1, 2);  // kDv, kDw
-      Eigen::MatrixX3d x(np, 3);
-      for (Eigen::Index p = 0; p < np; ++p) x.row(p) = rest.row(el.patch[p]);
+      const Eigen::MatrixX3d& x = el.reference;
       rest_a1_[e] = (centre.basis.row(1) * x).transpose();
       rest_a2_[e] = (centre.basis.row(2) * x).transpose();
       for (size_t q = 0; q < el.basis.size(); ++q) {
@@ -340,9 +342,9 @@ void CorotationalElements::evaluate(const Eigen::VectorXd& u) {
       const int* vertex = patch_vertex_.data() + offset / 3;
       if (identity_[e])
         for (Eigen::Index p = 0; p < np; ++p)
-          x.segment<3>(3 * p) = rest_patch_.segment<3>(offset + 3 * p) + u.segment<3>(3 * static_cast<Eigen::Index>(vertex[p]));
+          x.segment<3>(3 * p) = base_patch_.segment<3>(offset + 3 * p) + u.segment<3>(3 * static_cast<Eigen::Index>(vertex[p]));
       else
-        x = rest_patch_.segment(offset, 3 * np) + model_.patch_vector(static_cast<int>(e), u);
+        x = base_patch_.segment(offset, 3 * np) + model_.patch_vector(static_cast<int>(e), u);
       if (!corotational_ || frozen_rotations_) continue;
       const double* rows = tangent_rows_.data() + 2 * (offset / 3);
       Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
@@ -511,7 +513,7 @@ Eigen::VectorXd CorotationalElements::tension_force(const Eigen::VectorXd& u) co
   const std::vector<ShellElement>& elements = model_.elements();
   for (size_t e = 0; e < elements.size(); ++e) {
     const Eigen::Index np = (patch_offset_[e + 1] - patch_offset_[e]) / 3;
-    const Eigen::VectorXd x = rest_patch_.segment(patch_offset_[e], 3 * np) + model_.patch_vector(static_cast<int>(e), u);
+    const Eigen::VectorXd x = base_patch_.segment(patch_offset_[e], 3 * np) + model_.patch_vector(static_cast<int>(e), u);
     Eigen::VectorXd local = Eigen::VectorXd::Zero(3 * np);
     for (int q = point_offset_[e]; q < point_offset_[e + 1]; ++q) {
       const BasisMatrix& basis = elements[e].basis[static_cast<size_t>(q - point_offset_[e])];
@@ -535,7 +537,7 @@ Eigen::MatrixX2d CorotationalElements::membrane_principal_strains(const Eigen::V
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 64), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t e = range.begin(); e != range.end(); ++e) {
       const Eigen::VectorXd x =
-          rest_patch_.segment(patch_offset_[e], patch_offset_[e + 1] - patch_offset_[e]) + model_.patch_vector(static_cast<int>(e), u);
+          base_patch_.segment(patch_offset_[e], patch_offset_[e + 1] - patch_offset_[e]) + model_.patch_vector(static_cast<int>(e), u);
       const double* rows = tangent_rows_.data() + 2 * (patch_offset_[e] / 3);
       Eigen::Vector3d a1 = Eigen::Vector3d::Zero(), a2 = Eigen::Vector3d::Zero();
       for (Eigen::Index p = 0; p < x.size() / 3; ++p) {

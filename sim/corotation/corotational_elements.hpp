@@ -99,10 +99,12 @@ class CorotationalElements {
 
   const ShellModel& model_;
   bool corotational_;
-  // Per-element patch vectors (3·#patch each) in flat buffers from patch_offset_[e]: X_e, the
-  // current x_e and the local force, so that evaluate() allocates nothing.
+  // Per-element patch vectors (3·#patch each) in flat buffers from patch_offset_[e]: X_e (the
+  // patch at rest, ShellElement::reference), the mesh's positions that displacements are measured
+  // from (equal to X_e unless the rest state is a flat layout), the current x_e and the local
+  // force, so that evaluate() allocates nothing.
   std::vector<Eigen::Index> patch_offset_;
-  Eigen::VectorXd rest_patch_, x_patch_, local_force_;
+  Eigen::VectorXd rest_patch_, base_patch_, x_patch_, local_force_;
   // Per patch vertex (element e's from patch_offset_[e] / 3): ∂N/∂v, ∂N/∂w at the barycentre
   // (2 each) and the extended-mesh vertex; per element, whether its patch is the identity map.
   std::vector<double> tangent_rows_;

@@ -41,12 +41,16 @@ TriMesh LoopShellDiscretization::prepare_mesh(const TriMesh& mesh, const LogFn& 
 }
 
 LoopShellDiscretization::LoopShellDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary,
-                                                 const ShellMaterial& material, Quadrature quadrature)
-    : mesh_(mesh), model_(mesh, material, boundary, quadrature), rest_(to_flat(mesh.vertices)) {
+                                                 const ShellMaterial& material, Quadrature quadrature, RestShape rest)
+    : mesh_(mesh), model_(mesh, material, boundary, quadrature, rest), rest_(to_flat(mesh.vertices)) {
   for (int dof = 0; dof < 3 * mesh.num_vertices(); ++dof)
     if (status(dof) == DofStatus::dependent) dependent_.push_back(dof);
   const ExtendedMesh& ext = model_.extended();
   std::vector<Eigen::Triplet<double>> dv, dw;
+  // The rest tangents at the barycentres come from each element's patch at rest (the centre's
+  // vertices are the element's patch, in its order).
+  rest_dv_.resize(ext.num_real_triangles, 3);
+  rest_dw_.resize(ext.num_real_triangles, 3);
   for (int t = 0; t < ext.num_real_triangles; ++t) {
     const PatchEvaluation centre = evaluate_patch(ext.topology, ext.triangles[static_cast<size_t>(t)], 1.0 / 3, 1.0 / 3);
     for (size_t k = 0; k < centre.vertices.size(); ++k) {
@@ -54,13 +58,14 @@ LoopShellDiscretization::LoopShellDiscretization(const TriMesh& mesh, const std:
       if (centre.basis(kDv, col) != 0.0) dv.emplace_back(t, centre.vertices[k], centre.basis(kDv, col));
       if (centre.basis(kDw, col) != 0.0) dw.emplace_back(t, centre.vertices[k], centre.basis(kDw, col));
     }
+    const Eigen::MatrixX3d& reference = model_.elements()[static_cast<size_t>(t)].reference;
+    rest_dv_.row(t) = centre.basis.row(kDv) * reference;
+    rest_dw_.row(t) = centre.basis.row(kDw) * reference;
   }
   centre_dv_.resize(ext.num_real_triangles, ext.num_vertices());
   centre_dv_.setFromTriplets(dv.begin(), dv.end());
   centre_dw_.resize(ext.num_real_triangles, ext.num_vertices());
   centre_dw_.setFromTriplets(dw.begin(), dw.end());
-  rest_dv_ = centre_dv_ * ext.rest;
-  rest_dw_ = centre_dw_ * ext.rest;
 }
 
 void LoopShellDiscretization::make_consistent(Eigen::VectorXd& u) const {
@@ -72,7 +77,8 @@ void LoopShellDiscretization::make_consistent(Eigen::VectorXd& u) const {
 }
 
 Eigen::VectorXd LoopShellDiscretization::lumped_mass(double areal_density) const {
-  return lumped_vertex_mass(mesh_, areal_density);
+  return model_.rest_shape() == RestShape::pattern ? lumped_vertex_mass_uv(mesh_, areal_density)
+                                                   : lumped_vertex_mass(mesh_, areal_density);
 }
 
 Eigen::VectorXd LoopShellDiscretization::traction_load(

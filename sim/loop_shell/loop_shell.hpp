@@ -28,8 +28,10 @@ class LoopShellDiscretization final : public Discretization {
 
   // `mesh` must be prepared (prepare_mesh); `boundary` holds vertex ids of it. Throws
   // std::runtime_error (MeshError for mesh problems) naming the problem.
+  // `rest`: the elements' rest state (sim/shell/flat_rest.hpp); with RestShape::pattern the mass
+  // too comes from the texture-coordinate areas.
   LoopShellDiscretization(const TriMesh& mesh, const std::vector<BoundaryCondition>& boundary,
-                          const ShellMaterial& material, Quadrature quadrature);
+                          const ShellMaterial& material, Quadrature quadrature, RestShape rest = RestShape::initial);
 
   std::string method() const override { return "loop_kl"; }
   const TriMesh& mesh() const override { return mesh_; }

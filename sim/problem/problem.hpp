@@ -8,6 +8,7 @@
 #include "sim/mesh/mesh.hpp"
 #include "sim/boundary/boundary_condition.hpp"
 #include "sim/contact/obstacle.hpp"
+#include "sim/shell/flat_rest.hpp"
 #include "sim/shell/material.hpp"
 #include "sim/shell/quadrature.hpp"
 #include "sim/forces/follower_couples.hpp"
@@ -63,6 +64,9 @@ struct Problem {
   // (dynamic analyses only).
   std::string method = "loop_kl";
   TriMesh mesh;  // control mesh, prepared for the method (sim/setup/setup.hpp: prepare_mesh)
+  // The elements' rest state: the mesh as given, or flat, laid out from its texture coordinates
+  // in metres (a garment's pattern; sim/shell/flat_rest.hpp). The mesh's positions are the start.
+  RestShape rest = RestShape::initial;
   ShellMaterial material;
   std::vector<BoundaryCondition> boundary;  // dynamic: fixed components follow BoundaryCondition::motion
   // Gravity [m/s²]: lumped in a dynamic analysis, consistent in a static one (sim/forces/gravity.hpp).

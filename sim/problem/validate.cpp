@@ -48,6 +48,18 @@ std::optional<ProblemIssue> find_issue(const Problem& p, Analysis analysis) {
     return ProblemIssue{"material", "an orthotropic material needs the grain: a warp direction per triangle of the mesh "
                                     "(the mesh has " + std::to_string(p.mesh.warp.size()) + " for " +
                                     std::to_string(p.mesh.triangles.size()) + " triangles)"};
+  if (p.rest == RestShape::pattern) {
+    // The flat rest state differs from the start: only the corotational Loop element in a dynamic
+    // analysis measures its strains against a rest state of its own (linear statics would linearise
+    // about a start that is not at rest).
+    if (p.method != "loop_kl")
+      return ProblemIssue{"rest", "\"pattern\" (a flat rest state) needs \"method\": \"loop_kl\" (got \"" + p.method + "\")"};
+    if (!dynamic) return ProblemIssue{"rest", "\"pattern\" (a flat rest state) needs \"analysis\": \"dynamic\""};
+    if (!p.corotational) return ProblemIssue{"rest", "\"pattern\" (a flat rest state) needs \"corotational\": true"};
+    if (p.mesh.uv.size() != p.mesh.triangles.size())
+      return ProblemIssue{"rest", "\"pattern\" (a flat rest state) needs the pattern coordinates in metres as texture "
+                                  "coordinates on every triangle (a pattern mesh, or an OBJ with vt on every face)"};
+  }
   for (size_t i = 0; i < p.boundary.size(); ++i) {
     const BoundaryCondition& bc = p.boundary[i];
     const std::string key = index_key("boundary", i);

@@ -32,7 +32,8 @@ TriMesh prepare_mesh(const std::string& method, const TriMesh& mesh, const LogFn
 
 std::shared_ptr<Discretization> make_discretization(const Problem& problem) {
   if (problem.method == "loop_kl")
-    return std::make_shared<LoopShellDiscretization>(problem.mesh, problem.boundary, problem.material, problem.quadrature);
+    return std::make_shared<LoopShellDiscretization>(problem.mesh, problem.boundary, problem.material, problem.quadrature,
+                                                     problem.rest);
   if (problem.method == "linear_fe")
     return std::make_shared<LinearFeDiscretization>(problem.mesh, problem.boundary, problem.material);
   if (problem.method == "mass_spring")

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -72,25 +73,28 @@ Eigen::MatrixX3d patch_rows(const Eigen::MatrixX3d& x, const std::vector<int>& i
 }  // namespace
 
 ShellModel::ShellModel(const TriMesh& mesh, const ShellMaterial& material,
-                       const std::vector<BoundaryCondition>& conditions, Quadrature quadrature)
-    : ext_(build_ghost_layer(mesh)), dofs_(ext_, conditions), material_(material) {
+                       const std::vector<BoundaryCondition>& conditions, Quadrature quadrature, RestShape rest)
+    : ext_(build_ghost_layer(mesh)), dofs_(ext_, conditions), material_(material), rest_shape_(rest) {
   const std::vector<QuadraturePoint> rule = quadrature_points(quadrature);
   elements_.reserve(mesh.triangles.size());
   if (material.orthotropic() && mesh.warp.size() != mesh.triangles.size())
     throw std::invalid_argument("an orthotropic material needs a warp direction per triangle (the mesh has " +
                                 std::to_string(mesh.warp.size()) + " for " + std::to_string(mesh.num_triangles()) +
                                 " triangles)");
+  std::optional<FlatRestLayout> layout;
+  if (rest == RestShape::pattern) layout.emplace(mesh, ext_);
   for (int t = 0; t < mesh.num_triangles(); ++t) {
     const Triangle& tri = mesh.triangles[t];
     if (irregular_vertex_count(ext_, tri) > 1)
       throw MeshError("triangle " + std::to_string(t) + " has more than one irregular vertex; refine the mesh first");
     elements_.push_back(make_element(ext_, dofs_, tri, rule));
+    ShellElement& el = elements_.back();
+    el.reference = layout ? layout->patch(t, el.patch) : patch_rows(ext_.rest, el.patch);
     if (material.orthotropic()) {
-      elements_.back().warp = mesh.warp[static_cast<size_t>(t)];
+      el.warp = layout ? layout->to_layout(t, mesh.warp[static_cast<size_t>(t)]) : mesh.warp[static_cast<size_t>(t)];
       // Every quadrature point must see the grain (curvilinear_matrix throws otherwise).
-      const ShellElement& el = elements_.back();
       for (const BasisMatrix& b : el.basis) {
-        const SurfacePoint s = surface_point(b, patch_rows(ext_.rest, el.patch));
+        const SurfacePoint s = surface_point(b, el.reference);
         const Eigen::Vector3d w = el.warp - el.warp.dot(s.a3) * s.a3;
         if (!(w.norm() > 1e-6 * el.warp.norm()))
           throw std::invalid_argument("triangle " + std::to_string(t) +
@@ -179,7 +183,7 @@ void ShellModel::scatter_matrix(int e, const Matrix& local, double* values) cons
 
 Eigen::MatrixXd ShellModel::folded_element_stiffness(int e) const {
   const ShellElement& el = elements_[e];
-  const ElementMatrix k = element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, el.warp);
+  const ElementMatrix k = element_stiffness(el.basis, el.weights, el.reference, material_, el.warp);
   if (el.identity) return k;
   return fold_patch_matrix(el, k);
 }
@@ -195,7 +199,7 @@ Eigen::SparseMatrix<double> ShellModel::stiffness() const {
         const int e = group[i];
         const ShellElement& el = elements_[e];
         if (el.identity)
-          scatter_matrix(e, element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, el.warp), values);
+          scatter_matrix(e, element_stiffness(el.basis, el.weights, el.reference, material_, el.warp), values);
         else
           scatter_matrix(e, folded_element_stiffness(e), values);
       }
@@ -205,7 +209,7 @@ Eigen::SparseMatrix<double> ShellModel::stiffness() const {
 
 Eigen::MatrixXd ShellModel::patch_stiffness(int e) const {
   const ShellElement& el = elements_[e];
-  return element_stiffness(el.basis, el.weights, patch_rows(ext_.rest, el.patch), material_, el.warp);
+  return element_stiffness(el.basis, el.weights, el.reference, material_, el.warp);
 }
 
 Eigen::VectorXd ShellModel::patch_vector(int e, const Eigen::VectorXd& real) const {
@@ -263,11 +267,14 @@ Eigen::VectorXd ShellModel::surface_traction_load(
     const std::function<Eigen::Vector3d(const SurfacePoint&)>& traction) const {
   Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * num_vertices());
   for (const ShellElement& el : elements_) {
+    // The traction's direction from the mesh's positions, the area from the rest state (the same
+    // surface unless the rest state is a flat layout).
     const Eigen::MatrixX3d x = patch_rows(ext_.rest, el.patch);
     Eigen::VectorXd local = Eigen::VectorXd::Zero(3 * static_cast<Eigen::Index>(el.patch.size()));
     for (size_t k = 0; k < el.basis.size(); ++k) {
       const SurfacePoint s = surface_point(el.basis[k], x);
-      const Eigen::Vector3d t = (el.weights[k] * s.j) * traction(s);
+      const double j = rest_shape_ == RestShape::initial ? s.j : surface_point(el.basis[k], el.reference).j;
+      const Eigen::Vector3d t = (el.weights[k] * j) * traction(s);
       for (Eigen::Index p = 0; p < static_cast<Eigen::Index>(el.patch.size()); ++p)
         local.segment<3>(3 * p) += el.basis[k](kValue, p) * t;
     }

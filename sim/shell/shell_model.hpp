@@ -12,6 +12,7 @@
 #include "sim/boundary/boundary_condition.hpp"
 #include "sim/shell/dof_map.hpp"
 #include "sim/shell/element.hpp"
+#include "sim/shell/flat_rest.hpp"
 #include "sim/shell/ghost_layer.hpp"
 #include "sim/shell/material.hpp"
 #include "sim/shell/quadrature.hpp"
@@ -33,7 +34,10 @@ struct ShellElement {
   std::vector<double> weights;      // quadrature weights (sum 1/2)
   std::vector<int> real;            // real vertices the patch's displacements depend on
   bool identity = false;            // patch == real and every component free and itself
-  Eigen::Vector3d warp = Eigen::Vector3d::Zero();  // rest warp direction (TriMesh::warp; zero: none)
+  Eigen::Vector3d warp = Eigen::Vector3d::Zero();  // rest warp direction (TriMesh::warp; zero: none),
+                                                   // in the frame of `reference`
+  Eigen::MatrixX3d reference;       // the patch at rest (#patch × 3): the mesh's positions, or the
+                                    // flat layout (RestShape::pattern, flat_rest.hpp)
   Eigen::SparseMatrix<double> fold;  // 3·#patch × 3·#real weights (when !identity; most rows
                                      // are unit rows)
 };
@@ -48,9 +52,12 @@ std::vector<std::string> free_rigid_motions(const Eigen::Matrix<double, 6, 6>& g
 class ShellModel {
  public:
   // An orthotropic material needs the mesh's per-triangle warp directions (TriMesh::warp; throws
-  // std::invalid_argument naming what is missing otherwise).
+  // std::invalid_argument naming what is missing otherwise). With RestShape::pattern every
+  // element rests flat in its layout from the texture coordinates (flat_rest.hpp; throws MeshError
+  // naming the triangle when the layout cannot be made); the mesh's positions are still the
+  // configuration displacements are measured from.
   ShellModel(const TriMesh& mesh, const ShellMaterial& material, const std::vector<BoundaryCondition>& conditions,
-             Quadrature quadrature);
+             Quadrature quadrature, RestShape rest = RestShape::initial);
 
   int num_vertices() const { return ext_.num_real; }
   const ExtendedMesh& extended() const { return ext_; }
@@ -105,6 +112,8 @@ class ShellModel {
     scatter_vector(elements_[e], f_patch, global);
   }
 
+  RestShape rest_shape() const { return rest_shape_; }
+
   // Consistent load of a force per unit reference area q [N/m²]: f_I = ∫ N_I q dA.
   Eigen::VectorXd area_load(const Eigen::Vector3d& q) const;
   // Pressure p [N/m²] along the reference surface's unit normal a₃: f_I = ∫ N_I p a₃ dA.
@@ -129,6 +138,7 @@ class ShellModel {
   ExtendedMesh ext_;
   DofMap dofs_;
   ShellMaterial material_;
+  RestShape rest_shape_ = RestShape::initial;
   std::vector<ShellElement> elements_;
   // Sparsity of the stiffness (3 × 3 blocks between vertices sharing an element) and, per
   // element, the value offset of each block (a, b) of its real vertices at slots[a + m·b].

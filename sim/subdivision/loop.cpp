@@ -105,6 +105,16 @@ TriMesh loop_subdivide(const TriMesh& mesh, double corner_angle_deg) {
     for (const Eigen::Vector3d& w : mesh.warp)
       for (int k = 0; k < 4; ++k) out.warp.push_back(w);
   }
+  if (!mesh.uv.empty()) {  // the children's corners in the parent's texture space: its corners and edge midpoints
+    out.uv.reserve(4 * mesh.uv.size());
+    for (const auto& t : mesh.uv) {
+      const Eigen::Vector2d ab = 0.5 * (t[0] + t[1]), bc = 0.5 * (t[1] + t[2]), ca = 0.5 * (t[2] + t[0]);
+      out.uv.push_back({t[0], ab, ca});
+      out.uv.push_back({t[1], bc, ab});
+      out.uv.push_back({t[2], ca, bc});
+      out.uv.push_back({ab, bc, ca});
+    }
+  }
   return out;
 }
 

@@ -26,7 +26,9 @@ std::vector<double> limit_tangent_mask(int valence, int which /* 0: t1, 1: t2 */
 // vertices use the crease rules (edge ½ ½; vertex ⅛ ¾ ⅛), and border vertices where the border
 // turns by more than `corner_angle_deg` (or that have a single incident triangle) stay in place.
 // New vertex ids: old vertices keep their index, then one vertex per edge. Each triangle
-// (a, b, c) becomes four, in the order: corner a, corner b, corner c, middle.
+// (a, b, c) becomes four, in the order: corner a, corner b, corner c, middle. The children keep
+// their parent's warp direction; texture coordinates (TriMesh::uv) are split at the edge
+// midpoints (so a flat rest layout in uv stays the parent's, refined).
 TriMesh loop_subdivide(const TriMesh& mesh, double corner_angle_deg = 30.0);
 
 // The same step as a linear operator: new positions = S · old positions (S is #new × #old), with
