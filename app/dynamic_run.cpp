@@ -171,7 +171,7 @@ OrderedJson solver_json(const Problem& problem) {
   return j;
 }
 
-std::string summary_json(const Scene& scene, const RunTotals& totals, double wall_seconds,
+std::string summary_json(const Scene& scene, const RunTotals& totals, const SettleReport& settle, double wall_seconds,
                          const std::vector<std::string>& warnings, const std::string& status,
                          const std::string& error) {
   OrderedJson j = {{"scene", scene.name},
@@ -191,6 +191,11 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, double wal
                    {"overrides", scene.overrides},
                    {"warnings", warnings},
                    {"status", status}};
+  if (scene.problem.settle.time > 0)
+    j["settle"] = {{"time", scene.problem.settle.time},
+                   {"steps", settle.steps},
+                   {"membrane_strain_start", settle.strain_start},
+                   {"membrane_strain_end", settle.strain_end}};
   if (scene.problem.has_contact())
     j["contact"] = {{"pairs_tested", totals.contact.pairs_tested},
                     {"impulses", totals.contact.impulses},
@@ -514,6 +519,13 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
   } catch (const std::exception& e) {
     throw std::runtime_error(file + ": cannot set up the dynamic analysis: " + e.what());
   }
+  if (scene.problem.settle.time > 0) {
+    const SettleReport& settle = sim->settle_report();
+    log_line("settled for " + format_short(scene.problem.settle.time) + " s (" + std::to_string(settle.steps) +
+             " steps, loads off, obstacles held, no pins): largest membrane strain " +
+             format_short(100 * settle.strain_start) + " % at the start, " + format_short(100 * settle.strain_end) +
+             " % at the end");
+  }
   // The renderer and the refinement operator, also before any file is written.
   std::unique_ptr<LimitSurfaceDrawer> drawer;
   std::unique_ptr<render::Renderer> renderer;
@@ -631,7 +643,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
     try {
       // The "running" summary is padded with spaces, so that the final one can still be written
       // over it in place if the disk fills up (overwrite_in_place).
-      write_atomically(dir / "summary.json", summary_json(scene, totals, wall(), warnings, "running", "") +
+      write_atomically(dir / "summary.json", summary_json(scene, totals, sim->settle_report(), wall(), warnings, "running", "") +
                                                  std::string(4096, ' ') + "\n");
       if (drawer) {
         FrameResume r;
@@ -724,7 +736,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
                        " step(s) ended with contact pairs still colliding (steps " + list +
                        "); frames from those times on may show crossing surfaces");
   }
-  const std::string summary = summary_json(scene, totals, wall(), warnings, status, failure);
+  const std::string summary = summary_json(scene, totals, sim->settle_report(), wall(), warnings, status, failure);
   try {
     write_atomically(dir / "summary.json", summary);
   } catch (const std::exception& e) {

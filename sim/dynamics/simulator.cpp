@@ -11,6 +11,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -54,6 +55,7 @@ class ContactFilter final : public VelocityFilter, public StepPotential {
 
 struct Simulator::Impl {
   Problem problem;
+  SettleReport settle;
   std::shared_ptr<const Discretization> discretization;
   Eigen::VectorXd node_mass;
   std::vector<std::unique_ptr<ForceTerm>> internal;
@@ -101,8 +103,57 @@ struct Simulator::Impl {
   void skip_rotation_time() { shell_rotate_ms = shell ? shell->elements().total_rotate_ms() : 0.0; }
 };
 
+namespace {
+
+// The settling phase (Simulator's constructor): the problem with the loads off, the obstacles
+// held, no boundary conditions, strong mass damping, run for settle.time from rest; returns the
+// problem whose mesh starts where the settling ended.
+Problem settled(const Problem& p, SettleReport& report) {
+  Problem s = p;
+  s.settle = SettleSettings{};
+  s.gravity.setZero();
+  s.surface_load.setZero();
+  s.pressure = 0.0;
+  s.point_loads.clear();
+  s.moments.clear();
+  s.ramp_time = 0.0;
+  s.initial = InitialState{};
+  for (Obstacle& o : s.obstacles) o.motion.clear();
+  // Pins and other boundary conditions act from t = 0, where the settling leaves their vertices:
+  // held at the pieces' placed positions they would keep the seams next to them open.
+  s.boundary.clear();
+  s.damping.mass = std::max(s.damping.mass, p.settle.damping);
+  s.time.end = p.settle.time;
+  Problem out = p;
+  try {
+    Simulator sim(s);
+    report.strain_start = sim.max_membrane_strain();
+    report.steps = sim.num_steps();
+    for (int k = 0; k < report.steps; ++k) sim.step();
+    report.strain_end = sim.max_membrane_strain();
+    out.mesh.vertices = sim.state().positions();
+  } catch (const std::exception& e) {
+    throw std::runtime_error("while settling (the " + std::to_string(p.settle.time) + " s before t = 0): " + e.what());
+  }
+  return out;
+}
+
+}  // namespace
+
 Simulator::Simulator(const Problem& problem) {
   check_problem(problem, Analysis::dynamics);
+  if (problem.settle.time > 0) {
+    SettleReport report;
+    init(settled(problem, report));
+    impl_->settle = report;
+  } else {
+    init(problem);
+  }
+}
+
+const SettleReport& Simulator::settle_report() const { return impl_->settle; }
+
+void Simulator::init(const Problem& problem) {
   impl_ = std::make_unique<Impl>(problem);
   Impl& m = *impl_;
   const Discretization& d = *m.discretization;

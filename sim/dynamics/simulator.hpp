@@ -29,10 +29,25 @@ struct SimulatorCheckpoint {
   LinearSolverCheckpoint solver;
 };
 
+// What the settling phase did (Problem::settle): its steps, and the largest membrane strain of
+// the surface at its start and end (a garment's seams start open: the bands of cloth that join
+// them start stretched and relax while it settles).
+struct SettleReport {
+  int steps = 0;
+  double strain_start = 0.0;  // [-]
+  double strain_end = 0.0;    // [-]
+};
+
 class Simulator {
  public:
   // Throws std::runtime_error (MeshError for mesh problems) naming the problem for an invalid
   // description (bad material, time step, unsupported structure for the chosen solver, ...).
+  // With problem.settle.time > 0 it first settles the cloth: the same problem with the loads off,
+  // the obstacles held where they start, no boundary conditions (pins act from t = 0, where the
+  // settling leaves their vertices) and mass damping of at least settle.damping, run for
+  // settle.time; the run then starts (t = 0, at rest) from the settled positions, which replace
+  // the mesh's as the configuration displacements are measured from (so it needs a rest state of
+  // its own, RestShape::pattern). Deterministic, so a resumed run settles to the same start.
   explicit Simulator(const Problem& problem);
   ~Simulator();
   Simulator(const Simulator&) = delete;
@@ -86,12 +101,17 @@ class Simulator {
 
   // The state after the last step, for continuing the run later (restore()).
   SimulatorCheckpoint checkpoint() const;
+
+  // The settling phase's report (all zero without one).
+  const SettleReport& settle_report() const;
   // Continues from `c`, taken from a Simulator of the same problem: the next step() gives what
   // the original's next step gave, to the bit. Throws std::invalid_argument if `c` does not fit
   // the problem (mesh size, solver settings); the Simulator is then unusable.
   void restore(const SimulatorCheckpoint& c);
 
  private:
+  void init(const Problem& problem);
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -57,6 +57,14 @@ struct InitialState {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();            // [m]
 };
 
+// "settle": a phase before t = 0 in which a garment's seams close and its pieces relax onto the
+// body (sim/dynamics/simulator.hpp): loads off, obstacles and scripted boundaries held at their
+// start, strong mass damping; its end positions are where the run starts.
+struct SettleSettings {
+  double time = 0.0;      // [s] of settling (0: none)
+  double damping = 20.0;  // [1/s] mass damping while settling (at least the scene's damping.mass)
+};
+
 struct Problem {
   // The discretisation (sim/setup/setup.hpp: discretization_methods): "loop_kl", the Loop-
   // subdivision Kirchhoff–Love shell, "linear_fe", flat corotated membrane triangles with hinge
@@ -83,6 +91,7 @@ struct Problem {
   SolverSettings solver;
   bool corotational = true;  // false: plain linear element (for comparison)
   InitialState initial;
+  SettleSettings settle;
   // Contact (dynamic analysis only; sim/contact/): switched on by collision.self or any obstacle.
   CollisionSettings collision;
   std::vector<Obstacle> obstacles;

@@ -48,6 +48,11 @@ std::optional<ProblemIssue> find_issue(const Problem& p, Analysis analysis) {
     return ProblemIssue{"material", "an orthotropic material needs the grain: a warp direction per triangle of the mesh "
                                     "(the mesh has " + std::to_string(p.mesh.warp.size()) + " for " +
                                     std::to_string(p.mesh.triangles.size()) + " triangles)"};
+  if (p.settle.time > 0 && p.rest != RestShape::pattern)
+    return ProblemIssue{"settle", "needs a rest state of its own (\"rest\": \"pattern\"): the settled positions become the "
+                                  "start, and with \"rest\": \"initial\" the start is the rest state"};
+  if (!(std::isfinite(p.settle.time) && p.settle.time >= 0)) return ProblemIssue{"settle.time", "must be >= 0 [s]"};
+  if (!(std::isfinite(p.settle.damping) && p.settle.damping > 0)) return ProblemIssue{"settle.damping", "must be > 0 [1/s]"};
   if (p.rest == RestShape::pattern) {
     // The flat rest state differs from the start: only the corotational Loop element in a dynamic
     // analysis measures its strains against a rest state of its own (linear statics would linearise

@@ -5,11 +5,13 @@
 #include "sim/mesh/generators.hpp"
 #include "sim/mesh/grain.hpp"
 #include "sim/mesh/obj_io.hpp"
+#include "sim/scene/read_pattern.hpp"
 
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace clothsim {
 namespace scene_io {
@@ -34,15 +36,45 @@ void obj_grain(const Reader& r, TriMesh& mesh, const GrainSpec& grain, bool need
   }
 }
 
+// A pattern garment: the pieces sewn into one mesh (sim/pattern/pattern.hpp), each piece with its
+// own grain.
+TriMesh build_pattern_mesh(const Reader& r, const Json& j, const LogFn& log, long long max_vertices,
+                           const GrainSpec& grain, std::optional<SewnPattern>& pattern) {
+  r.check_object(j, "mesh", {"pattern", "rotate", "translate", "max_vertices"});
+  if (grain.given)
+    r.fail("material.grain", "a pattern mesh takes its grain from its pieces (mesh.pattern.pieces[i].grain_deg, "
+                             "degrees from the piece's +x axis); remove material.grain");
+  const PatternSpec spec = read_pattern(r, j["pattern"], "mesh.pattern");
+  try {
+    pattern = SewnPattern{spec, build_pattern(spec)};
+  } catch (const MeshLimitError& e) {
+    r.fail("mesh.pattern.edge_length", std::string(e.what()) + " (use a larger edge length)");
+  } catch (const std::exception& e) {
+    r.fail("mesh.pattern", e.what());
+  }
+  check_vertex_count(r, "mesh.pattern.edge_length", "the pattern", pattern->built.mesh.num_vertices(), max_vertices);
+  double gap = 0;
+  for (const double g : pattern->built.seam_gap) gap = std::max(gap, g);
+  log("mesh: pattern of " + std::to_string(spec.pieces.size()) + " piece(s) and " + std::to_string(spec.seams.size()) +
+      " seam(s), edge length " + format_number(spec.edge_length) + " m: " + std::to_string(pattern->built.mesh.num_vertices()) +
+      " vertices, " + std::to_string(pattern->built.mesh.num_triangles()) + " triangles; largest seam gap as placed " +
+      format_number(gap) + " m");
+  return pattern->built.mesh;
+}
+
 TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log,
-                         long long max_vertices, const GrainSpec& grain, bool need_grain) {
+                         long long max_vertices, const GrainSpec& grain, bool need_grain,
+                         std::optional<SewnPattern>& pattern) {
   const std::string path = "mesh";
   if (!j.is_object()) r.fail(path, "expected an object (got " + describe(j) + ")");
   const bool has_obj = j.contains("obj");
   const bool has_primitive = j.contains("primitive");
-  if (has_obj && has_primitive) r.fail(path, "give either \"obj\" or \"primitive\", not both");
-  if (!has_obj && !has_primitive)
-    r.fail(path, "needs \"obj\" (a file) or \"primitive\" (allowed: \"grid\", \"cylinder\")");
+  const bool has_pattern = j.contains("pattern");
+  if (static_cast<int>(has_obj) + static_cast<int>(has_primitive) + static_cast<int>(has_pattern) > 1)
+    r.fail(path, "give one of \"obj\", \"primitive\" and \"pattern\"");
+  if (!has_obj && !has_primitive && !has_pattern)
+    r.fail(path, "needs \"obj\" (a file), \"primitive\" (allowed: \"grid\", \"cylinder\") or \"pattern\" (sewn pieces)");
+  if (has_pattern) return build_pattern_mesh(r, j, log, max_vertices, grain, pattern);
 
   if (has_obj) {
     r.check_object(j, path, {"obj", "rotate", "translate", "max_vertices"});  // (the others: build_mesh)
@@ -125,7 +157,7 @@ void check_vertex_count(const Reader& r, const std::string& path, const std::str
 }
 
 TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& folder, const LogFn& log,
-                   long long max_vertices, const GrainSpec& grain, bool need_grain) {
+                   long long max_vertices, const GrainSpec& grain, bool need_grain, std::optional<SewnPattern>& pattern) {
   if (!j.is_object()) r.fail("mesh", "expected an object (got " + describe(j) + ")");
   Json shape = j;
   shape.erase("max_vertices");  // (read by read_max_vertices)
@@ -143,7 +175,7 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
     translation = r.vec3(*tr, "mesh.translate");
     shape.erase("translate");
   }
-  TriMesh mesh = build_mesh_shape(r, shape, folder, log, max_vertices, grain, need_grain);
+  TriMesh mesh = build_mesh_shape(r, shape, folder, log, max_vertices, grain, need_grain, pattern);
   if (j.contains("rotate") || j.contains("translate")) {
     for (Eigen::Index v = 0; v < mesh.vertices.rows(); ++v)
       mesh.vertices.row(v) = (rotation * mesh.vertices.row(v).transpose() + translation).transpose();

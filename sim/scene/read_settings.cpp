@@ -265,6 +265,15 @@ void read_output(const Reader& r, const Json* j, Scene& scene) {
   }
 }
 
+SettleSettings read_settle(const Reader& r, const Json* j) {
+  SettleSettings s;
+  if (j == nullptr) return s;
+  r.check_object(*j, "settle", {"time", "damping"});
+  if (const Json* v = r.find(*j, "time")) s.time = r.non_negative(*v, "settle.time", "[s]");
+  if (const Json* v = r.find(*j, "damping")) s.damping = r.positive(*v, "settle.damping", "[1/s]");
+  return s;
+}
+
 Imperfection read_imperfection(const Reader& r, const Json* j) {
   Imperfection imp;
   if (j == nullptr) return imp;

@@ -40,6 +40,9 @@ InitialState read_initial(const Reader& r, const Json* j);
 // is written for --resume.
 void read_output(const Reader& r, const Json* j, Scene& scene);
 
+// "settle": {"time": s >= 0, "damping": 1/s > 0}.
+SettleSettings read_settle(const Reader& r, const Json* j);
+
 // "imperfection": {"amplitude": m, "seed": int >= 0, "wavelength": [min, max] m}.
 Imperfection read_imperfection(const Reader& r, const Json* j);
 

@@ -5,6 +5,7 @@
 
 #include "sim/scene/build_mesh.hpp"
 #include "sim/scene/json_reader.hpp"
+#include "sim/scene/read_pattern.hpp"
 #include "sim/scene/read_settings.hpp"
 
 #include "sim/mesh/imperfection.hpp"
@@ -18,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -31,7 +33,7 @@ const char* const kAxes[3] = {"x", "y", "z"};
 
 // Top-level keys that only a dynamic scene may have.
 const char* const kDynamicOnlyKeys[] = {"time", "damping", "solver", "corotational", "initial", "output", "collision",
-                                        "obstacles"};
+                                        "obstacles", "settle"};
 
 const char* const kNeedsDynamic = "needs \"analysis\": \"dynamic\" (this scene is static)";
 
@@ -61,12 +63,35 @@ void check_travel(const Reader& r, const Motion& m, const std::string& path, con
 
 // `select`: {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} → the control vertices in the
 // closed box (at least one).
-std::vector<int> read_selection(const Reader& r, const Json& item, const std::string& path, const TriMesh& mesh) {
+// A boundary's or a load's "select": {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} (the
+// vertices inside it) or, on a pattern garment, {"piece_edge": {"piece": name, "edge": i or
+// [first, last]}} (the vertices along the piece's edge or path of edges).
+std::vector<int> read_selection(const Reader& r, const Json& item, const std::string& path, const TriMesh& mesh,
+                                const SewnPattern* pattern) {
   const std::string select_path = join_key(path, "select");
   const Json& select = r.require(item, path, "select");
-  r.check_object(select, select_path, {"box"});
+  r.check_object(select, select_path, {"box", "piece_edge"});
+  if (select.contains("box") == select.contains("piece_edge"))
+    r.fail(select_path, "give one of \"box\" and \"piece_edge\"");
+  if (const Json* edge = r.find(select, "piece_edge")) {
+    const std::string edge_path = join_key(select_path, "piece_edge");
+    if (pattern == nullptr) r.fail(edge_path, "needs a pattern mesh (\"mesh\": {\"pattern\": ...})");
+    const SeamSide side = read_piece_edge(r, *edge, edge_path, pattern->spec);
+    std::size_t piece = 0;
+    while (pattern->spec.pieces[piece].name != side.piece) ++piece;
+    const auto& edges = pattern->built.edge_vertices[piece];
+    const int n = static_cast<int>(edges.size());
+    std::vector<int> vertices;
+    for (int e = side.first_edge;; e = (e + 1) % n) {
+      vertices.insert(vertices.end(), edges[static_cast<std::size_t>(e)].begin(), edges[static_cast<std::size_t>(e)].end());
+      if (e == side.last_edge) break;
+    }
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    return vertices;
+  }
   const std::string box_path = join_key(select_path, "box");
-  const Json& box = r.require(select, select_path, "box");
+  const Json& box = select["box"];
   if (!box.is_array() || box.size() != 2)
     r.fail(box_path, "expected an array of 2 points [[xmin, ymin, zmin], [xmax, ymax, zmax]] (got " +
                          describe(box) + ")");
@@ -82,7 +107,8 @@ std::vector<int> read_selection(const Reader& r, const Json& item, const std::st
   return vertices;
 }
 
-std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, const TriMesh& mesh, bool dynamic,
+std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, const TriMesh& mesh,
+                                             const SewnPattern* pattern, bool dynamic,
                                              const LogFn& log) {
   std::vector<BoundaryCondition> out;
   if (j == nullptr) return out;
@@ -92,7 +118,7 @@ std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, con
     const Json& item = (*j)[i];
     r.check_object(item, path, {"select", "fix", "rotation", "motion"});
     BoundaryCondition bc;
-    bc.vertices = read_selection(r, item, path, mesh);
+    bc.vertices = read_selection(r, item, path, mesh, pattern);
 
     if (const Json* fix = r.find(item, "fix")) {
       const std::string fix_path = join_key(path, "fix");
@@ -148,7 +174,8 @@ void check_near_mesh(const Reader& r, const Eigen::MatrixX3d& vertices, int vert
                      format_number(diagonal) + " m, its bounding box's diagonal); give a point on or near the mesh");
 }
 
-void read_loads(const Reader& r, const Json* j, Problem& problem, double* ramp_time, const LogFn& log) {
+void read_loads(const Reader& r, const Json* j, Problem& problem, const SewnPattern* pattern, double* ramp_time,
+                const LogFn& log) {
   if (j == nullptr) return;
   r.check_object(*j, "loads", {"gravity", "surface_load", "pressure", "point_loads", "moments", "ramp_time"});
   if (const Json* ramp = r.find(*j, "ramp_time")) {
@@ -162,7 +189,7 @@ void read_loads(const Reader& r, const Json* j, Problem& problem, double* ramp_t
       const Json& item = (*moments)[i];
       r.check_object(item, path, {"select", "moment"});
       MomentLoad load;
-      load.vertices = read_selection(r, item, path, problem.mesh);
+      load.vertices = read_selection(r, item, path, problem.mesh, pattern);
       load.moment = r.vec3(r.require(item, path, "moment"), join_key(path, "moment"));
       log(path + ": " + std::to_string(load.vertices.size()) + " vertices");
       problem.moments.push_back(std::move(load));
@@ -445,7 +472,7 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   r.check_object(root, "",
                  {"name", "description", "analysis", "method", "mesh", "material", "boundary", "loads", "probes",
                   "numerics", "time", "damping", "solver", "corotational", "initial", "output", "render",
-                  "collision", "obstacles", "imperfection", "$schema"});
+                  "collision", "obstacles", "imperfection", "rest", "settle", "$schema"});
   // "$schema": the JSON Schema the file follows (scenes/scene.schema.json), for editors; ignored.
   if (const Json* schema = r.find(root, "$schema")) r.string(*schema, "$schema");
 
@@ -509,8 +536,14 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   const Json& mesh_json = r.require(root, "", "mesh");
   const bool draw_grain = scene.render.texture == "grain";
   grain.needed_by = scene.problem.material.orthotropic() ? "material" : "render.texture";
+  std::optional<SewnPattern> pattern;
   TriMesh mesh = build_mesh(r, mesh_json, file.parent_path(), say, max_vertices, grain,
-                            grain.given || scene.problem.material.orthotropic() || draw_grain);
+                            grain.given || scene.problem.material.orthotropic() || draw_grain, pattern);
+  // "rest": the elements' rest state (sim/shell/flat_rest.hpp); a pattern garment rests flat.
+  scene.problem.rest = pattern ? RestShape::pattern : RestShape::initial;
+  if (const Json* rest = r.find(root, "rest"))
+    scene.problem.rest = r.choice(*rest, "rest", {"pattern", "initial"}) == "pattern" ? RestShape::pattern : RestShape::initial;
+  if (dynamic) scene.problem.settle = read_settle(r, r.find(root, "settle"));
   warn_about_cracks(mesh, mesh_json.contains("obj"), say);
   // An obstacle's translations too are measured against the cloth (the scene's scale).
   for (std::size_t i = 0; i < scene.problem.obstacles.size(); ++i)
@@ -522,13 +555,17 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   } catch (const std::exception& e) {
     r.fail("mesh", e.what());
   }
+  if (pattern && scene.problem.mesh.num_vertices() != mesh.num_vertices())
+    r.fail("mesh.pattern", "the pattern mesh was refined for the method, so its piece edges no longer name its "
+                           "vertices (report this: the pattern builder isolates irregular vertices itself)");
   if (scene.problem.mesh.num_vertices() > max_vertices)
     r.fail("mesh", "prepared for the method (refined once by Loop subdivision) it has " +
                        std::to_string(scene.problem.mesh.num_vertices()) + " vertices, more than mesh.max_vertices = " +
                        std::to_string(max_vertices) + " (raise mesh.max_vertices to allow it)");
 
-  scene.problem.boundary = read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, dynamic, say);
-  read_loads(r, r.find(root, "loads"), scene.problem, dynamic ? &dyn.ramp_time : nullptr, say);
+  scene.problem.boundary =
+      read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, pattern ? &*pattern : nullptr, dynamic, say);
+  read_loads(r, r.find(root, "loads"), scene.problem, pattern ? &*pattern : nullptr, dynamic ? &dyn.ramp_time : nullptr, say);
   check_load_magnitudes(r, scene.problem, say);
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
   // The boundary and probes were selected on the mesh as placed; the imperfection then changes

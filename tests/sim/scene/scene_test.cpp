@@ -154,7 +154,7 @@ TEST_F(SceneLoader, UnknownKeysAtAnyLevel) {
                        expected("mesh.radius: unknown key (allowed: primitive, size, divisions, rotate, translate, max_vertices)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 +
                              R"(, "boundary": [{"select": {"box": [[0, 0, 0], [1, 1, 1]], "sphere": 1}}]})"),
-                       expected("boundary[0].select.sphere: unknown key (allowed: box)")));
+                       expected("boundary[0].select.sphere: unknown key (allowed: box, piece_edge)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "probes": [{"name": "a", "at": [0, 0, 0], "x": 1}]})"),
                        expected("probes[0].x: unknown key (allowed: name, at)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "numerics": {"solver": "cg"}})"),
@@ -272,7 +272,7 @@ TEST_F(SceneLoader, BrokenOrMissingObjNamesMeshObj) {
   const std::string bad = error(R"({"mesh": {"obj": "bad.obj"}})");
   EXPECT_TRUE(contains(bad, expected("mesh.obj: "))) << bad;
   EXPECT_TRUE(contains(bad, "bad.obj")) << bad;
-  EXPECT_TRUE(contains(error(R"({"mesh": {"obj": "bad.obj", "primitive": "grid"}})"), expected("mesh: give either")));
+  EXPECT_TRUE(contains(error(R"({"mesh": {"obj": "bad.obj", "primitive": "grid"}})"), expected("mesh: give one of \"obj\", \"primitive\" and \"pattern\"")));
 }
 
 TEST_F(SceneLoader, ShippedScenesLoad) {
@@ -519,7 +519,7 @@ TEST_F(SceneLoader, DynamicKeysRejectedInStaticScene) {
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "timestep": 0.01})"),
                        expected("timestep: unknown key (allowed: name, description, analysis, method, mesh, material, "
                                 "boundary, loads, probes, numerics, time, damping, solver, corotational, initial, output, "
-                                "render, collision, obstacles, imperfection, $schema)")));
+                                "render, collision, obstacles, imperfection, rest, settle, $schema)")));
 }
 
 TEST_F(SceneLoader, DynamicSettingErrors) {

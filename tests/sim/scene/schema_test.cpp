@@ -204,6 +204,11 @@ const std::vector<Place>& places() {
       {"obstacle_box", "every dynamic key", "/obstacles/3", "obstacles[3]"},
       {"obstacle_cylinder", "every dynamic key", "/obstacles/4", "obstacles[4]"},
       {"obstacle_obj", "every dynamic key", "/obstacles/5", "obstacles[5]"},
+      {"mesh_pattern", "every pattern key", "/mesh", "mesh"},
+      {"pattern_piece", "every pattern key", "/mesh/pattern/pieces/0", "mesh.pattern.pieces[0]"},
+      {"pattern_seam", "every pattern key", "/mesh/pattern/seams/0", "mesh.pattern.seams[0]"},
+      {"piece_edge", "every pattern key", "/mesh/pattern/seams/0/a", "mesh.pattern.seams[0].a"},
+      {"settle", "every pattern key", "/settle", "settle"},
   };
   return p;
 }
@@ -270,6 +275,7 @@ TEST(SceneSchema, EveryEnumerationHasTheLoadersValues) {
        schema_values(defs["solver"]["properties"]["preconditioner"])},
       {"every dynamic key", "/solver/warm_start", "solver.warm_start", schema_values(defs["solver"]["properties"]["warm_start"])},
       {"every dynamic key", "/mesh/primitive", "mesh.primitive", variant_values("mesh", "primitive")},
+      {"every pattern key", "/rest", "rest", schema_values(schema()["properties"]["rest"])},
       {"every dynamic key", "/boundary/0/motion/0/type", "boundary[0].motion[0].type", variant_values("motion", "type")},
       {"every dynamic key", "/obstacles/1/primitive", "obstacles[1].primitive", variant_values("obstacle", "primitive")},
   };

@@ -1,0 +1,121 @@
+// Pattern garments in scene files (scenes/README.md, Pattern garments): "mesh": {"pattern": ...}
+// as the issue writes it, "rest", "settle" and boundaries selected by a piece's edge; errors that
+// name the key; and a skirt whose seams start open settling closed.
+#include "sim/scene/scene.hpp"
+
+#include "sim/dynamics/simulator.hpp"
+#include "sim/pattern/pattern.hpp"
+
+#include "tests/support/scene_files.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace clothsim {
+namespace {
+
+class PatternScene : public testing::SceneFileTest {};
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+// The tube skirt of issue 30's scene contract: front and back, their side edges 3.4 cm apart.
+const char* const kSkirt = R"("mesh": {"pattern": {
+  "edge_length": 0.02,
+  "pieces": [
+    {"name": "front", "points": [[-0.25, 0.0], [0.25, 0.0], [0.25, 0.5], [-0.25, 0.5]],
+     "grain_deg": 90,
+     "placement": {"wrap": {"radius": 0.17}, "rotate_deg": [0, 0, 0], "translate": [0, 0.45, 0]}},
+    {"name": "back", "points": [[-0.25, 0.0], [0.25, 0.0], [0.25, 0.5], [-0.25, 0.5]],
+     "placement": {"wrap": {"radius": 0.17}, "rotate_deg": [0, 180, 0], "translate": [0, 0.45, 0]}}
+  ],
+  "seams": [{"a": {"piece": "front", "edge": 1}, "b": {"piece": "back", "edge": 3}, "reversed": true},
+            {"a": {"piece": "front", "edge": 3}, "b": {"piece": "back", "edge": 1}, "reversed": true}]
+}})";
+
+std::string dynamic(const std::string& extra) {
+  return std::string(R"({"analysis": "dynamic", )") + kSkirt + R"(, "material": {"preset": "cotton"},
+    "time": {"dt": 0.005, "end": 0.01})" + extra + "}";
+}
+
+TEST_F(PatternScene, TheContractsSkirtIsSewnAndRestsFlat) {
+  const Scene s = load(dynamic(R"(, "settle": {"time": 0.5})"));
+  // The same mesh as the builder makes from the same pieces and seams.
+  PatternSpec spec;
+  spec.edge_length = 0.02;
+  for (const char* name : {"front", "back"}) {
+    PatternPiece p;
+    p.name = name;
+    p.points = {{-0.25, 0.0}, {0.25, 0.0}, {0.25, 0.5}, {-0.25, 0.5}};
+    p.grain_deg = std::string(name) == "front" ? 90 : 0;
+    p.placement.wrap_radius = 0.17;
+    p.placement.rotate_deg = {0, std::string(name) == "front" ? 0.0 : 180.0, 0};
+    p.placement.translate = {0, 0.45, 0};
+    spec.pieces.push_back(p);
+  }
+  spec.seams = {{{"front", 1, 1}, {"back", 3, 3}, true}, {{"front", 3, 3}, {"back", 1, 1}, true}};
+  const PatternMesh built = build_pattern(spec);
+  ASSERT_EQ(s.problem.mesh.num_vertices(), built.mesh.num_vertices());
+  EXPECT_EQ((s.problem.mesh.vertices - built.mesh.vertices).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(s.problem.mesh.uv.size(), s.problem.mesh.triangles.size());
+  EXPECT_EQ(s.problem.rest, RestShape::pattern);  // the default for a pattern mesh
+  EXPECT_EQ(s.problem.settle.time, 0.5);
+  EXPECT_EQ(s.problem.settle.damping, 20.0);
+  // "rest": "initial" keeps the placed shape as the rest state (today's behaviour).
+  EXPECT_EQ(load(dynamic(R"(, "rest": "initial")")).problem.rest, RestShape::initial);
+}
+
+TEST_F(PatternScene, ABoundaryCanSelectAPiecesEdge) {
+  const Scene s = load(dynamic(R"(, "boundary": [
+    {"select": {"piece_edge": {"piece": "front", "edge": 2}}, "fix": ["x", "y", "z"]},
+    {"select": {"piece_edge": {"piece": "back", "edge": [1, 3]}}, "fix": ["y"]}])"));
+  ASSERT_EQ(s.problem.boundary.size(), 2u);
+  // The top edge of the front: 0.5 m at a control edge of about 2 cm, corner to corner, at y = 0.95.
+  const std::vector<int>& top = s.problem.boundary[0].vertices;
+  EXPECT_EQ(top.size(), 27u);
+  for (const int v : top) EXPECT_NEAR(s.problem.mesh.vertices(v, 1), 0.95, 1e-12);
+  // The back's path 1..3: its right side, top and left side (two of them sewn to the front).
+  EXPECT_EQ(s.problem.boundary[1].vertices.size(), 3u * 27u - 2u);
+}
+
+TEST_F(PatternScene, ErrorsNameTheKey) {
+  EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece_edge": {"piece": "frnot", "edge": 2}}, "fix": ["x"]}])")),
+                       "boundary[0].select.piece_edge.piece: no piece \"frnot\" (pieces: \"front\", \"back\"); did you mean \"front\"?"));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece_edge": {"piece": "front", "edge": 4}}, "fix": ["x"]}])")),
+                       "boundary[0].select.piece_edge.edge: piece \"front\" has edges 0 to 3"));
+  EXPECT_TRUE(contains(error(R"({"analysis": "dynamic", "mesh": {"primitive": "grid", "size": [0.2, 0.1], "divisions": [4, 2]},
+      "boundary": [{"select": {"piece_edge": {"piece": "front", "edge": 0}}, "fix": ["x"]}]})"),
+                       "boundary[0].select.piece_edge: needs a pattern mesh"));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"box": [[-1, -1, -1], [1, 1, 1]], "piece_edge": {"piece": "front", "edge": 0}}, "fix": ["x"]}])")),
+                       "boundary[0].select: give one of \"box\" and \"piece_edge\""));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "rest": "initial", "settle": {"time": 0.5})")),
+                       "settle: needs a rest state of its own (\"rest\": \"pattern\")"));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "settle": {"time": -1})")), "settle.time: must be >= 0 [s]"));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "rest": "flat")")), "rest: unknown value \"flat\""));
+  EXPECT_TRUE(contains(error(std::string("{") + kSkirt + "}"), "rest: \"pattern\" (a flat rest state) needs \"analysis\": \"dynamic\""));
+  EXPECT_TRUE(contains(error(std::string("{") + kSkirt + R"(, "settle": {"time": 1}})"), "settle: needs \"analysis\": \"dynamic\""));
+  EXPECT_TRUE(contains(error(R"({"analysis": "dynamic", )" + std::string(kSkirt) +
+                             R"(, "material": {"preset": "cotton_broadcloth_ortho", "grain": {"warp_deg": 10}}})"),
+                       "material.grain: a pattern mesh takes its grain from its pieces"));
+  // The builder's errors come back under the pattern's key.
+  std::string bad = dynamic("");
+  bad.replace(bad.find("[0.25, 0.5], [-0.25, 0.5]]"), 26, "[0.25, 0.48], [-0.25, 0.48]]");
+  EXPECT_TRUE(contains(error(bad), "mesh.pattern: ")) << error(bad);
+  EXPECT_TRUE(contains(error(bad), "differ by")) << error(bad);
+}
+
+TEST_F(PatternScene, AnOpenSkirtSettlesClosed) {
+  // Seams 3.4 cm apart as placed: the bands of cloth that join them start stretched by more than
+  // 100 %; after half a second of settling (no gravity, strong damping) less than 0.1 % is left.
+  Scene s = load(dynamic(R"(, "settle": {"time": 0.5})"));
+  const Simulator sim(s.problem);
+  EXPECT_GT(sim.settle_report().strain_start, 1.0);
+  EXPECT_LT(sim.settle_report().strain_end, 1e-3);
+  EXPECT_EQ(sim.settle_report().steps, 100);
+  // The run starts at rest where the settling ended.
+  EXPECT_EQ(sim.state().v.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_LT(sim.max_membrane_strain(), 1e-3);
+}
+
+}  // namespace
+}  // namespace clothsim
