@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 namespace clothsim {
@@ -59,6 +60,15 @@ TriMesh build_pattern_mesh(const Reader& r, const Json& j, const LogFn& log, lon
       " seam(s), edge length " + format_number(spec.edge_length) + " m: " + std::to_string(pattern->built.mesh.num_vertices()) +
       " vertices, " + std::to_string(pattern->built.mesh.num_triangles()) + " triangles; largest seam gap as placed " +
       format_number(gap) + " m");
+  if (!pattern->built.seam_gap.empty()) {
+    std::string gaps;
+    char buffer[48];
+    for (std::size_t i = 0; i < pattern->built.seam_gap.size(); ++i) {
+      std::snprintf(buffer, sizeof buffer, "%s%zu: %.3g", i > 0 ? ", " : "", i, pattern->built.seam_gap[i]);
+      gaps += buffer;
+    }
+    log("mesh: seam gaps as placed [m] (seam: gap): " + gaps);
+  }
   return pattern->built.mesh;
 }
 

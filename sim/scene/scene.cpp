@@ -9,6 +9,7 @@
 #include "sim/scene/read_settings.hpp"
 
 #include "sim/mesh/imperfection.hpp"
+#include "sim/mesh/mesh_part.hpp"
 #include "sim/mesh/obj_io.hpp"
 #include "sim/problem/validate.hpp"
 #include "sim/setup/setup.hpp"
@@ -237,7 +238,7 @@ std::vector<Obstacle> read_obstacles(const Reader& r, const Json* j, double defa
     std::vector<std::string> allowed = {"name", "friction", "motion"};
     if (has_obj) {
       o.shape = Obstacle::Shape::mesh;
-      allowed.push_back("obj");
+      allowed.insert(allowed.end(), {"obj", "keep", "cut"});
     } else {
       const std::string shape =
           r.choice(item["primitive"], key("primitive"), {"plane", "sphere", "capsule", "box", "cylinder"}, "primitive");
@@ -308,6 +309,33 @@ std::vector<Obstacle> read_obstacles(const Reader& r, const Json* j, double defa
           r.fail(key("obj"), e.what());
         }
         if (o.mesh.num_triangles() == 0) r.fail(key("obj"), obj.string() + ": no triangles");
+        if (item.contains("keep") || item.contains("cut")) {
+          // A part of the mesh, cut out by planes (sim/mesh/mesh_part.hpp).
+          const auto half_spaces = [&](const Json& list, const std::string& at) {
+            r.array(list, at);
+            std::vector<HalfSpace> out_list;
+            for (std::size_t h = 0; h < list.size(); ++h) {
+              const std::string hp = join_index(at, h);
+              r.check_object(list[h], hp, {"point", "normal"});
+              HalfSpace half;
+              half.point = r.vec3(r.require(list[h], hp, "point"), join_key(hp, "point"));
+              half.normal = r.vec3(r.require(list[h], hp, "normal"), join_key(hp, "normal"));
+              if (!(half.normal.norm() > 0)) r.fail(join_key(hp, "normal"), "must be a non-zero vector");
+              out_list.push_back(half);
+            }
+            return out_list;
+          };
+          std::vector<HalfSpace> keep;
+          std::vector<std::vector<HalfSpace>> cut;
+          if (const Json* k = r.find(item, "keep")) keep = half_spaces(*k, key("keep"));
+          if (const Json* c = r.find(item, "cut")) {
+            r.array(*c, key("cut"));
+            for (std::size_t g = 0; g < c->size(); ++g) cut.push_back(half_spaces((*c)[g], join_index(key("cut"), g)));
+          }
+          o.mesh = mesh_part(o.mesh, keep, cut);
+          if (o.mesh.num_triangles() == 0)
+            r.fail(item.contains("keep") ? key("keep") : key("cut"), "leaves no triangle of " + obj.string());
+        }
         break;
       }
     }

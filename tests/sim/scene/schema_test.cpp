@@ -209,6 +209,7 @@ const std::vector<Place>& places() {
       {"pattern_seam", "every pattern key", "/mesh/pattern/seams/0", "mesh.pattern.seams[0]"},
       {"piece_edge", "every pattern key", "/mesh/pattern/seams/0/a", "mesh.pattern.seams[0].a"},
       {"settle", "every pattern key", "/settle", "settle"},
+      {"half_space", "obj obstacle part", "/obstacles/0/keep/0", "obstacles[0].keep[0]"},
   };
   return p;
 }
