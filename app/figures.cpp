@@ -77,6 +77,8 @@ std::vector<RunSpec> run_specs() {
   // The scene's own camera cuts the top of the uncompressed sleeve: one step further back.
   runs.push_back({"metal_compress", "metal_compress.json",
                   Json{{"render", {{"camera", {{"eye", {0.27, 0.21, 0.345}}, {"target", {0, 0.09, 0}}}}}}}, true});
+  runs.push_back({"sweater_on_body", "sweater_on_body.json", Json::object(), false});
+  runs.push_back({"trousers_pinned", "trousers_pinned.json", Json::object(), false});
   return runs;
 }
 
@@ -127,6 +129,13 @@ std::vector<FigureSpec> figure_specs() {
                      5,
                      {{"metal_compress", 0.1}, {"metal_compress", 0.3}, {"metal_compress", 0.6},
                       {"metal_compress", 1.0}, {"metal_compress", 1.5}}});
+  figures.push_back({12,
+                     "Fig. 12: garments sewn from pattern pieces: a sweater on a body, trousers hung from their hems",
+                     "Left: a woman wearing a sweater (a virtual try-on: the garment, sewn from a front, a back and "
+                     "two sleeves, settles on the body and follows its arms as they rise). Right: a pair of trousers "
+                     "pinned at the ends of the legs hangs under gravity, showing catenary folds and buckling.",
+                     2,
+                     {{"sweater_on_body", 1.5}, {"trousers_pinned", 3.0}}});
   return figures;
 }
 
@@ -175,6 +184,17 @@ PreparedRun prepare(const RunSpec& spec, const fs::path& scenes_dir, double need
   }
   scene.merge_patch(spec.patch);
   scene["name"] = spec.id;
+  // The run's scene is written next to the other runs': file paths in it (the mesh's and the
+  // obstacles' OBJ files) are made absolute against the shipped scene's folder.
+  const auto absolute = [&](Json& holder) {
+    if (holder.is_object() && holder.contains("obj") && holder["obj"].is_string()) {
+      const fs::path file = holder["obj"].get<std::string>();
+      if (file.is_relative()) holder["obj"] = fs::absolute(scenes_dir / file).lexically_normal().string();
+    }
+  };
+  if (scene.contains("mesh")) absolute(scene["mesh"]);
+  if (scene.contains("obstacles") && scene["obstacles"].is_array())
+    for (Json& o : scene["obstacles"]) absolute(o);
   if (spec.sleeve) scene["output"] = Json{{"obj", true}, {"obj_level", 1}};
   run.method = scene.value("method", std::string("loop_kl"));
   run.material = material_label(scene.value("material", Json::object()));

@@ -297,7 +297,7 @@ int task_command(int argc, char** argv) {
 
 // `clothsim figures [N ...] [--out DIR] [--size WxH] [--quick] [--rerun]`.
 int figures_command(int argc, char** argv) {
-  CLI::App app{"clothsim figures: reproduces the paper's Figs. 1 and 7-11 from shipped scenes: runs the\n"
+  CLI::App app{"clothsim figures: reproduces the paper's Figs. 1 and 7-12 from shipped scenes: runs the\n"
                "scenes (or reuses completed runs of the same scenes) and writes DIR/figures/figN.png\n"
                "(labelled panels), figN.md and figures.md (which scene and settings made each panel,\n"
                "fold counts); see docs/figures.md.",

@@ -97,7 +97,7 @@ TEST_F(FiguresCli, QuickFigure10IsPublishedLabelledAndReproducible) {
 TEST_F(FiguresCli, BadArgumentsAreErrorsThatWriteNothing) {
   const fs::path out = dir_ / "out";
   EXPECT_EQ(figures("2 --out " + shell_quote(out.string())), 1);
-  EXPECT_NE(err_.find("no figure 2 (allowed: 1 7 8 9 10 11)"), std::string::npos) << err_;
+  EXPECT_NE(err_.find("no figure 2 (allowed: 1 7 8 9 10 11 12)"), std::string::npos) << err_;
   EXPECT_EQ(figures("7 --size 64x48abc --out " + shell_quote(out.string())), 1);
   EXPECT_NE(err_.find("--size"), std::string::npos) << err_;
   EXPECT_EQ(figures("seven --out " + shell_quote(out.string())), 1);
