@@ -41,7 +41,7 @@ void obj_grain(const Reader& r, TriMesh& mesh, const GrainSpec& grain, bool need
 // own grain.
 TriMesh build_pattern_mesh(const Reader& r, const Json& j, const LogFn& log, long long max_vertices,
                            const GrainSpec& grain, std::optional<SewnPattern>& pattern) {
-  r.check_object(j, "mesh", {"pattern", "rotate", "translate", "max_vertices"});
+  r.check_object(j, "mesh", {"pattern", "rotate", "translate", "max_vertices", "fit_limit"});
   if (grain.given)
     r.fail("material.grain", "a pattern mesh takes its grain from its pieces (mesh.pattern.pieces[i].grain_deg, "
                              "degrees from the piece's +x axis); remove material.grain");
@@ -87,7 +87,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
   if (has_pattern) return build_pattern_mesh(r, j, log, max_vertices, grain, pattern);
 
   if (has_obj) {
-    r.check_object(j, path, {"obj", "rotate", "translate", "max_vertices"});  // (the others: build_mesh)
+    r.check_object(j, path, {"obj", "rotate", "translate", "max_vertices", "fit_limit"});  // (the others: build_mesh)
     const std::string key = "mesh.obj";
     const std::string name = r.string(j["obj"], key);
     if (name.empty()) r.fail(key, "expected a non-empty file path");
@@ -112,7 +112,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
   TriMesh mesh;
   try {
     if (primitive == "grid") {
-      r.check_object(j, path, {"primitive", "size", "divisions", "rotate", "translate", "max_vertices"});
+      r.check_object(j, path, {"primitive", "size", "divisions", "rotate", "translate", "max_vertices", "fit_limit"});
       const Json& size = r.sized_array(r.require(j, path, "size"), "mesh.size", 2, "numbers");
       const Json& div = r.sized_array(r.require(j, path, "divisions"), "mesh.divisions", 2, "integers");
       const double sx = r.positive(size[0], "mesh.size[0]", "[m]");
@@ -128,7 +128,7 @@ TriMesh build_mesh_shape(const Reader& r, const Json& j, const std::filesystem::
     } else {
       r.check_object(j, path,
                      {"primitive", "radius", "length", "segments", "rings", "angle_deg", "rotate", "translate",
-                      "max_vertices"});
+                      "max_vertices", "fit_limit"});
       const double radius = r.positive(r.require(j, path, "radius"), "mesh.radius", "[m]");
       const double length = r.positive(r.require(j, path, "length"), "mesh.length", "[m]");
       double angle = 360.0;
@@ -171,6 +171,7 @@ TriMesh build_mesh(const Reader& r, const Json& j, const std::filesystem::path& 
   if (!j.is_object()) r.fail("mesh", "expected an object (got " + describe(j) + ")");
   Json shape = j;
   shape.erase("max_vertices");  // (read by read_max_vertices)
+  shape.erase("fit_limit");     // (applied by the scene loader, which knows the method)
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
   Eigen::Vector3d translation = Eigen::Vector3d::Zero();
   if (const Json* rot = r.find(j, "rotate")) {

@@ -13,6 +13,7 @@
 #include "sim/mesh/obj_io.hpp"
 #include "sim/problem/validate.hpp"
 #include "sim/setup/setup.hpp"
+#include "sim/shell/fit_limit.hpp"
 
 #include <Eigen/Geometry>
 
@@ -573,6 +574,20 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
     scene.problem.rest = r.choice(*rest, "rest", {"pattern", "initial"}) == "pattern" ? RestShape::pattern : RestShape::initial;
   if (dynamic) scene.problem.settle = read_settle(r, r.find(root, "settle"));
   warn_about_cracks(mesh, mesh_json.contains("obj"), say);
+  // "mesh.fit_limit": control vertices whose limit points are the mesh's vertices (the paper's
+  // §7 limitation lifted; sim/shell/fit_limit.hpp).
+  if (const Json* fit = r.find(mesh_json, "fit_limit"); fit != nullptr && r.boolean(*fit, "mesh.fit_limit")) {
+    if (scene.problem.method != "loop_kl")
+      r.fail("mesh.fit_limit", "needs \"method\": \"loop_kl\" (the other methods draw the mesh itself)");
+    try {
+      const LimitFit fitted = fit_limit(mesh);
+      mesh = fitted.control;
+      say("mesh: fitted to its limit surface (the limit points are the mesh's vertices to " +
+          format_number(fitted.residual) + " of its size)");
+    } catch (const std::exception& e) {
+      r.fail("mesh.fit_limit", e.what());
+    }
+  }
   // An obstacle's translations too are measured against the cloth (the scene's scale).
   for (std::size_t i = 0; i < scene.problem.obstacles.size(); ++i)
     for (std::size_t m = 0; m < scene.problem.obstacles[i].motion.size(); ++m)

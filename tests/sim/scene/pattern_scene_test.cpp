@@ -4,7 +4,9 @@
 #include "sim/scene/scene.hpp"
 
 #include "sim/dynamics/simulator.hpp"
+#include "sim/mesh/generators.hpp"
 #include "sim/pattern/pattern.hpp"
+#include "sim/shell/shell_model.hpp"
 
 #include "tests/support/scene_files.hpp"
 
@@ -115,6 +117,32 @@ TEST_F(PatternScene, AnOpenSkirtSettlesClosed) {
   // The run starts at rest where the settling ended.
   EXPECT_EQ(sim.state().v.cwiseAbs().maxCoeff(), 0.0);
   EXPECT_LT(sim.max_membrane_strain(), 1e-3);
+}
+
+}  // namespace
+}  // namespace clothsim
+
+namespace clothsim {
+namespace {
+
+class FitLimitScene : public testing::SceneFileTest {};
+
+TEST_F(FitLimitScene, TheLimitSurfacePassesThroughTheMeshAsGiven) {
+  // A 16-segment cylinder: its control points lie on the cylinder, its limit surface inside it;
+  // with mesh.fit_limit the limit points are the given vertices.
+  const std::string mesh = R"("primitive": "cylinder", "radius": 0.05, "length": 0.2, "segments": 16, "rings": 9)";
+  const Scene plain = load(std::string(R"({"mesh": {)") + mesh + "}}");
+  const Scene fitted = load(std::string(R"({"mesh": {)") + mesh + R"(, "fit_limit": true}})");
+  const TriMesh given = make_cylinder(0.05, 0.2, 16, 9);
+  const auto limit_points = [](const Scene& s) {
+    const ShellModel model(s.problem.mesh, s.problem.material, {}, Quadrature::one_point);
+    return Eigen::MatrixX3d(model.limit_points(model.extended().rest));
+  };
+  EXPECT_LT((limit_points(fitted) - given.vertices).cwiseAbs().maxCoeff(), 1e-9 * 0.2);
+  EXPECT_GT((limit_points(plain) - given.vertices).cwiseAbs().maxCoeff(), 1e-4);  // 16 segments: about 0.3 mm inside
+  EXPECT_TRUE(contains(error(std::string(R"({"method": "linear_fe", "mesh": {)") + mesh + R"(, "fit_limit": true}})"),
+                       "mesh.fit_limit: needs \"method\": \"loop_kl\""));
+  EXPECT_TRUE(contains(error(std::string(R"({"mesh": {)") + mesh + R"(, "fit_limit": 1}})"), "mesh.fit_limit: expected true or false"));
 }
 
 }  // namespace

@@ -151,7 +151,7 @@ TEST_F(SceneLoader, UnknownKeysAtAnyLevel) {
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "colour": "red"})"),
                        expected("colour: unknown key (allowed: name, description, analysis, method, mesh")));
   EXPECT_TRUE(contains(error(R"({"mesh": {"primitive": "grid", "size": [1, 1], "divisions": [4, 4], "radius": 1}})"),
-                       expected("mesh.radius: unknown key (allowed: primitive, size, divisions, rotate, translate, max_vertices)")));
+                       expected("mesh.radius: unknown key (allowed: primitive, size, divisions, rotate, translate, max_vertices, fit_limit)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 +
                              R"(, "boundary": [{"select": {"box": [[0, 0, 0], [1, 1, 1]], "sphere": 1}}]})"),
                        expected("boundary[0].select.sphere: unknown key (allowed: box, piece_edge)")));
