@@ -391,7 +391,7 @@ namespace {
 std::vector<FigureSpec> wanted_figures(const FiguresOptions& options) {
   for (int n : options.figures)
     if (std::find(figure_numbers().begin(), figure_numbers().end(), n) == figure_numbers().end())
-      throw std::invalid_argument("no figure " + std::to_string(n) + " (allowed: 1 7 8 9 10 11)");
+      throw std::invalid_argument("no figure " + std::to_string(n) + " (allowed: 1 7 8 9 10 11 12)");
   std::vector<FigureSpec> wanted;
   for (const FigureSpec& f : figure_specs())
     if (options.figures.empty() ||

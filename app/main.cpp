@@ -304,7 +304,7 @@ int figures_command(int argc, char** argv) {
                "clothsim figures"};
   clothsim::FiguresOptions options;
   std::string out = options.out_root.string(), size;
-  app.add_option("figures", options.figures, "Figure numbers (1 7 8 9 10 11); none: all")->type_name("N ...");
+  app.add_option("figures", options.figures, "Figure numbers (1 7 8 9 10 11 12); none: all")->type_name("N ...");
   app.add_option("--out", out, "Output root; the figures go to DIR/figures/")->type_name("DIR")->capture_default_str();
   app.add_option("--size", size, "Panel size, default 480x360")->type_name("WxH");
   app.add_flag("--quick", options.quick, "Runs of 2 frames only (seconds; the panels do not show the figure)");
@@ -328,7 +328,7 @@ int figures_command(int argc, char** argv) {
   for (int n : options.figures)
     if (std::find(clothsim::figure_numbers().begin(), clothsim::figure_numbers().end(), n) ==
         clothsim::figure_numbers().end()) {
-      std::cerr << "clothsim: error: figures: no figure " << n << " (allowed: 1 7 8 9 10 11)\n";
+      std::cerr << "clothsim: error: figures: no figure " << n << " (allowed: 1 7 8 9 10 11 12)\n";
       return 1;
     }
   return clothsim::run_figures(options, sweep);

@@ -338,7 +338,7 @@ TEST_F(ContactKeys, ObstacleShapeAndKeyErrors) {
                        expected("obstacles[0].radius: unknown key (allowed: name, friction, motion, primitive, point, normal)")));
   write("body.obj", kTetrahedronObj);
   EXPECT_TRUE(contains(error(with_obstacles(R"([{"obj": "body.obj", "center": [0, 0, 0]}])")),
-                       expected("obstacles[0].center: unknown key (allowed: name, friction, motion, obj)")));
+                       expected("obstacles[0].center: unknown key (allowed: name, friction, motion, obj, keep, cut)")));
   EXPECT_EQ(error(with_obstacles(R"([{"obj": "body.obj", "primitive": "sphere", "center": [0, 0, 0], "radius": 0.1}])")),
             expected("obstacles[0]: give either \"obj\" or \"primitive\", not both"));
   const std::string neither = error(with_obstacles(R"([{"name": "x", "center": [0, 0, 0], "radius": 0.1}])"));
