@@ -15,6 +15,7 @@
 #include "sim/contact/obstacle.hpp"
 #include "sim/dynamics/simulator.hpp"
 #include "sim/mesh/obj_io.hpp"
+#include "sim/subdivision/loop.hpp"
 #include "sim/scene/render_settings_json.hpp"
 
 #include <nlohmann/json.hpp>
@@ -274,17 +275,25 @@ class Outputs {
                                     std::to_string(totals.frames) + ", step " + std::to_string(step) +
                                     ", t = " + format_double(t) + " s";
         if (scene_.obj_level == 0) {
-          write_obj((dir_ / "frames" / file).string(), sim.node_points(), scene_.problem.mesh.triangles, comment);
+          const auto& uv = scene_.problem.mesh.uv;  // a pattern's coordinates, or the OBJ's vt
+          write_obj((dir_ / "frames" / file).string(), sim.node_points(), scene_.problem.mesh.triangles, comment, nullptr,
+                    uv.size() == scene_.problem.mesh.triangles.size() ? &uv : nullptr);
         } else {  // the surface drawn at render.refine = obj_level (render.surface), with its normals
-          if (obj_surface_.num_points() == 0)
+          if (obj_surface_.num_points() == 0) {
             obj_surface_ = sim.discretization().drawn_display(scene_.obj_level, scene_.render.surface);
+            // The fine triangles' texture coordinates: each control triangle's, split as it is.
+            const auto& uv = scene_.problem.mesh.uv;
+            if (uv.size() == scene_.problem.mesh.triangles.size() &&
+                obj_surface_.triangles.size() == uv.size() << (2 * obj_surface_.levels))
+              obj_uv_ = refine_corner_uv(uv, obj_surface_.levels);
+          }
           Eigen::MatrixX3d p, n;
           obj_surface_.evaluate(sim.discretization().control_net(sim.state().x), p, n);
           write_obj((dir_ / "frames" / file).string(), p, obj_surface_.triangles,
                     comment + " (refined " + std::to_string(scene_.obj_level) + " times: " +
                         drawn_surface_description(scene_.problem.method, scene_.render.surface, scene_.obj_level) +
                         ")",
-                    &n);
+                    &n, obj_uv_.empty() ? nullptr : &obj_uv_);
         }
         // The obstacles (every one but planes) as they stand at this frame, as the contact sees them:
         // `check_intersections mesh_NNNN.obj obstacles_NNNN.obj` checks a frame against them.
@@ -348,6 +357,7 @@ class Outputs {
   FrameImages* images_;
   SurfaceOperator probe_points_;  // the probes' surface points
   SurfaceOperator obj_surface_;   // output.obj_level > 0: the refined surface of the OBJ frames
+  std::vector<std::array<Eigen::Vector2d, 3>> obj_uv_;  // its texture coordinates (empty: none)
   Eigen::MatrixX3d probe_rest_;   // their rest positions [m]
   StreamFile probes_;
   StreamFile stats_;

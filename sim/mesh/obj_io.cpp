@@ -9,6 +9,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <tuple>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -260,11 +262,15 @@ TriMesh read_obj(std::istream& in, const std::string& path, long long max_vertic
 }
 
 void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices, const std::vector<Triangle>& triangles,
-               const std::string& comment, const Eigen::MatrixX3d* normals) {
+               const std::string& comment, const Eigen::MatrixX3d* normals,
+               const std::vector<std::array<Eigen::Vector2d, 3>>* uv) {
   const Eigen::Index n = vertices.rows();
   if (normals != nullptr && normals->rows() != n)
     throw MeshError("cannot write '" + path + "': " + std::to_string(normals->rows()) + " normals for " +
                     std::to_string(n) + " vertices");
+  if (uv != nullptr && uv->size() != triangles.size())
+    throw MeshError("cannot write '" + path + "': texture coordinates for " + std::to_string(uv->size()) +
+                    " triangles, the mesh has " + std::to_string(triangles.size()));
   for (std::size_t t = 0; t < triangles.size(); ++t)
     for (const int v : triangles[t])
       if (v < 0 || v >= n)
@@ -318,12 +324,35 @@ void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices, const 
       put((*normals)(v, 2));
       out << '\n';
     }
-  for (const Triangle& tri : triangles) {
-    if (normals != nullptr)
-      out << "f " << tri[0] + 1 << "//" << tri[0] + 1 << ' ' << tri[1] + 1 << "//" << tri[1] + 1 << ' ' << tri[2] + 1
-          << "//" << tri[2] + 1 << '\n';
-    else
-      out << "f " << tri[0] + 1 << ' ' << tri[1] + 1 << ' ' << tri[2] + 1 << '\n';
+  // Texture coordinates: one `vt` per distinct (vertex, u, v), so a vertex on a seam has one per
+  // piece and the others one.
+  std::vector<std::array<int, 3>> corner_vt;
+  if (uv != nullptr) {
+    std::map<std::tuple<int, double, double>, int> index;
+    corner_vt.resize(triangles.size());
+    for (std::size_t t = 0; t < triangles.size(); ++t)
+      for (std::size_t k = 0; k < 3; ++k) {
+        const Eigen::Vector2d& c = (*uv)[t][k];
+        const auto [it, added] = index.emplace(std::make_tuple(triangles[t][k], c.x(), c.y()), static_cast<int>(index.size()));
+        if (added) {
+          out << "vt ";
+          put(c.x());
+          out << ' ';
+          put(c.y());
+          out << '\n';
+        }
+        corner_vt[t][k] = it->second;
+      }
+  }
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Triangle& tri = triangles[t];
+    out << 'f';
+    for (std::size_t k = 0; k < 3; ++k) {
+      out << ' ' << tri[k] + 1;
+      if (uv != nullptr) out << '/' << corner_vt[t][k] + 1;
+      if (normals != nullptr) out << (uv != nullptr ? "/" : "//") << tri[k] + 1;
+    }
+    out << '\n';
   }
 
   out.close();

@@ -47,13 +47,16 @@ inline constexpr std::size_t kMaxObjLineLength = std::size_t{1} << 20;
 // Writes `vertices` [m] and `triangles` (0-based, written 1-based) to an OBJ file, with every
 // coordinate printed in the shortest form that reads back to the identical double. A non-empty
 // `comment` is written as a leading `# comment` line (each line of a multi-line comment gets its
-// own `#`). With `normals` (#V × 3, unit) it writes `vn` lines and faces `f a//a b//b c//c`.
+// own `#`). With `normals` (#V × 3, unit) it writes `vn` lines and faces `f a//a b//b c//c`; with
+// `uv` (per triangle, its corners' texture coordinates, as TriMesh::uv) `vt` lines, one per
+// distinct vertex and coordinate pair, and faces `f a/ta b/tb c/tc` (`a/ta/a` with normals).
 // The file is written to a temporary sibling and renamed into place, so it is whole or absent.
 // Throws MeshError (before touching the file) if a triangle has an out-of-range index or the
 // normals do not match the vertices, and std::runtime_error naming the path if the file cannot
 // be written.
 void write_obj(const std::string& path, const Eigen::MatrixX3d& vertices,
                const std::vector<Triangle>& triangles, const std::string& comment = "",
-               const Eigen::MatrixX3d* normals = nullptr);
+               const Eigen::MatrixX3d* normals = nullptr,
+               const std::vector<std::array<Eigen::Vector2d, 3>>* uv = nullptr);
 
 }  // namespace clothsim

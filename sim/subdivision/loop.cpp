@@ -105,17 +105,28 @@ TriMesh loop_subdivide(const TriMesh& mesh, double corner_angle_deg) {
     for (const Eigen::Vector3d& w : mesh.warp)
       for (int k = 0; k < 4; ++k) out.warp.push_back(w);
   }
-  if (!mesh.uv.empty()) {  // the children's corners in the parent's texture space: its corners and edge midpoints
-    out.uv.reserve(4 * mesh.uv.size());
-    for (const auto& t : mesh.uv) {
-      const Eigen::Vector2d ab = 0.5 * (t[0] + t[1]), bc = 0.5 * (t[1] + t[2]), ca = 0.5 * (t[2] + t[0]);
-      out.uv.push_back({t[0], ab, ca});
-      out.uv.push_back({t[1], bc, ab});
-      out.uv.push_back({t[2], ca, bc});
-      out.uv.push_back({ab, bc, ca});
-    }
-  }
+  // The children's corners in the parent's texture space: its corners and edge midpoints.
+  if (!mesh.uv.empty()) out.uv = refine_corner_uv(mesh.uv, 1);
   return out;
+}
+
+std::vector<std::array<Eigen::Vector2d, 3>> refine_corner_uv(const std::vector<std::array<Eigen::Vector2d, 3>>& uv,
+                                                             int levels) {
+  std::vector<std::array<Eigen::Vector2d, 3>> current = uv;
+  for (int level = 0; level < levels; ++level) {
+    std::vector<std::array<Eigen::Vector2d, 3>> next;
+    next.reserve(4 * current.size());
+    for (const auto& t : current) {
+      // (x + y) / 2 is symmetric in x and y, so a midpoint shared by two triangles is the same double.
+      const Eigen::Vector2d ab = 0.5 * (t[0] + t[1]), bc = 0.5 * (t[1] + t[2]), ca = 0.5 * (t[2] + t[0]);
+      next.push_back({t[0], ab, ca});
+      next.push_back({t[1], bc, ab});
+      next.push_back({t[2], ca, bc});
+      next.push_back({ab, bc, ca});
+    }
+    current = std::move(next);
+  }
+  return current;
 }
 
 }  // namespace clothsim

@@ -7,6 +7,7 @@
 
 #include <Eigen/SparseCore>
 
+#include <array>
 #include <vector>
 
 namespace clothsim {
@@ -30,6 +31,13 @@ std::vector<double> limit_tangent_mask(int valence, int which /* 0: t1, 1: t2 */
 // their parent's warp direction; texture coordinates (TriMesh::uv) are split at the edge
 // midpoints (so a flat rest layout in uv stays the parent's, refined).
 TriMesh loop_subdivide(const TriMesh& mesh, double corner_angle_deg = 30.0);
+
+// Per-corner texture coordinates (TriMesh::uv) of the triangles `levels` 1-to-4 splits make, in
+// the order of loop_subdivision_step (fine triangle i descends from triangle i / 4^levels; each
+// split gives corner a, corner b, corner c, middle, with the new corners at the edge midpoints).
+// The uv of a point shared by two triangles with equal corner uv comes out bit for bit equal.
+std::vector<std::array<Eigen::Vector2d, 3>> refine_corner_uv(const std::vector<std::array<Eigen::Vector2d, 3>>& uv,
+                                                             int levels);
 
 // The same step as a linear operator: new positions = S · old positions (S is #new × #old), with
 // the refined triangles. Corner decisions use `positions` (#V × 3).

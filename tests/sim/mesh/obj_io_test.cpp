@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -87,6 +88,36 @@ TEST_F(ObjIoTest, RoundTripIsBitExact) {
       EXPECT_TRUE(same_bits(back.vertices(v, k), mesh.vertices(v, k)))
           << "vertex " << v << " coordinate " << k << ": " << back.vertices(v, k) << " vs " << mesh.vertices(v, k);
   EXPECT_EQ(back.triangles, mesh.triangles);
+}
+
+TEST_F(ObjIoTest, TextureCoordinatesRoundTripOnePerVertexAndPair) {
+  // Two triangles of the unit square: their shared edge has equal coordinates on both sides
+  // (4 vt), then different ones on one side, as across a seam between two pattern pieces (6 vt).
+  TriMesh m;
+  m.vertices.resize(4, 3);
+  m.vertices << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const Eigen::Vector2d a(0.1, 0.2), b(1.1, 0.2), c(1.1, 1.2), d(0.1, 1.2);
+  for (const bool seam : {false, true}) {
+    std::vector<std::array<Eigen::Vector2d, 3>> uv = {{a, b, c}, {a, c, d}};
+    if (seam) uv[1] = {Eigen::Vector2d(5, 5), Eigen::Vector2d(6, 6), d};
+    const std::string path = (dir_ / "uv.obj").string();
+    Eigen::MatrixX3d normals = Eigen::MatrixX3d::Zero(4, 3);
+    normals.col(2).setOnes();
+    write_obj(path, m.vertices, m.triangles, "", &normals, &uv);
+    std::ifstream in(path);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::size_t count = 0;
+    for (std::size_t at = text.find("\nvt "); at != std::string::npos; at = text.find("\nvt ", at + 1)) ++count;
+    EXPECT_EQ(count + (text.rfind("vt ", 0) == 0 ? 1 : 0), seam ? 6u : 4u) << text;
+    EXPECT_NE(text.find("f 1/1/1 2/2/2 3/3/3"), std::string::npos) << text;
+    const TriMesh back = read_obj(path);
+    ASSERT_EQ(back.uv.size(), 2u);
+    for (std::size_t t = 0; t < 2; ++t)
+      for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(back.uv[t][k], uv[t][k]) << t << ' ' << k;
+  }
+  std::vector<std::array<Eigen::Vector2d, 3>> one = {{a, b, c}};
+  EXPECT_THROW(write_obj((dir_ / "bad.obj").string(), m.vertices, m.triangles, "", nullptr, &one), MeshError);
 }
 
 TEST_F(ObjIoTest, WritesOneBasedFacesAndNoCommentWhenEmpty) {

@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <set>
+#include <utility>
 
 namespace clothsim {
 namespace {
@@ -92,6 +94,50 @@ TEST_P(LimitRefinementTest, ControlVerticesGoToTheirLimitPoints) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Valences, LimitRefinementTest, ::testing::Values(3, 5, 6, 8, 12));
+
+}  // namespace
+}  // namespace clothsim
+
+namespace clothsim {
+namespace {
+
+// refine_corner_uv (sim/subdivision/loop.hpp): the texture coordinates of the refined surface's
+// triangles, as the OBJ frames write them.
+TEST(RefineCornerUv, SplitsLikeTheSubdivisionAndKeepsAreaAndSharedPoints) {
+  const std::vector<std::array<Eigen::Vector2d, 3>> uv = {
+      {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.3, 0), Eigen::Vector2d(0, 0.2)},
+      {Eigen::Vector2d(0.3, 0), Eigen::Vector2d(0.3, 0.2), Eigen::Vector2d(0, 0.2)}};
+  const auto area = [](const std::array<Eigen::Vector2d, 3>& t) {
+    const Eigen::Vector2d e1 = t[1] - t[0], e2 = t[2] - t[0];
+    return 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+  };
+  for (int levels = 0; levels <= 3; ++levels) {
+    const auto fine = refine_corner_uv(uv, levels);
+    ASSERT_EQ(fine.size(), uv.size() << (2 * levels));
+    double total = 0;
+    for (const auto& t : fine) {
+      EXPECT_GT(area(t), 0.0);  // orientation kept
+      total += area(t);
+    }
+    EXPECT_NEAR(total, 0.06, 1e-15);
+  }
+  // One split: corner a, corner b, corner c, middle, as loop_subdivision_step orders them.
+  const auto one = refine_corner_uv(uv, 1);
+  EXPECT_EQ(one[0][0], uv[0][0]);
+  EXPECT_EQ(one[1][0], uv[0][1]);
+  EXPECT_EQ(one[2][0], uv[0][2]);
+  EXPECT_EQ(one[3][0], Eigen::Vector2d(0.15, 0));
+  // The two triangles share the edge (0.3, 0)–(0, 0.2): its midpoint is the same double in both.
+  const auto two = refine_corner_uv(uv, 2);
+  std::set<std::pair<double, double>> first, second;
+  for (std::size_t i = 0; i < 16; ++i)
+    for (const auto& p : two[i]) first.insert({p.x(), p.y()});
+  for (std::size_t i = 16; i < 32; ++i)
+    for (const auto& p : two[i]) second.insert({p.x(), p.y()});
+  int shared = 0;
+  for (const auto& p : first) shared += static_cast<int>(second.count(p));
+  EXPECT_EQ(shared, 5);  // the 5 points of a twice-split edge
+}
 
 }  // namespace
 }  // namespace clothsim

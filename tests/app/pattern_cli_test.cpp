@@ -1,0 +1,58 @@
+// A pattern garment's run through the command line: its OBJ frames carry the pattern coordinates
+// as texture coordinates (vt), at the control connectivity and on the refined surface, so the
+// frames can be textured in other tools; summary.json reports the settling.
+#include "sim/mesh/obj_io.hpp"
+
+#include "tests/support/cli_fixture.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace clothsim {
+namespace {
+
+class PatternCli : public testing::CliFixture {};
+
+// The tube skirt of scenes/README.md, no body, a few steps.
+const char* const kSkirt = R"({"name": "skirt", "analysis": "dynamic",
+  "mesh": {"pattern": {"edge_length": 0.05, "pieces": [
+    {"name": "front", "points": [[-0.25, 0.0], [0.25, 0.0], [0.25, 0.5], [-0.25, 0.5]],
+     "placement": {"wrap": {"radius": 0.17}, "translate": [0, 0.45, 0]}},
+    {"name": "back", "points": [[-0.25, 0.0], [0.25, 0.0], [0.25, 0.5], [-0.25, 0.5]],
+     "placement": {"wrap": {"radius": 0.17}, "rotate_deg": [0, 180, 0], "translate": [0, 0.45, 0]}}],
+    "seams": [{"a": {"piece": "front", "edge": 1}, "b": {"piece": "back", "edge": 3}, "reversed": true},
+              {"a": {"piece": "front", "edge": 3}, "b": {"piece": "back", "edge": 1}, "reversed": true}]}},
+  "material": {"preset": "cotton"}, "settle": {"time": 0.05},
+  "time": {"dt": 0.01, "end": 0.02, "output_fps": 50}, "output": {"obj": true, "obj_level": LEVEL}})";
+
+double uv_area(const TriMesh& m) {
+  double a = 0;
+  for (const auto& t : m.uv) {
+    const Eigen::Vector2d e1 = t[1] - t[0], e2 = t[2] - t[0];
+    a += 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+  }
+  return a;
+}
+
+TEST_F(PatternCli, ObjFramesCarryThePatternCoordinates) {
+  for (const int level : {0, 1}) {
+    std::string text = kSkirt;
+    text.replace(text.find("LEVEL"), 5, std::to_string(level));
+    const auto scene = write("skirt.json", text);
+    const testing::CliResult r = run(q(scene) + " --no-render --out " + q(dir_ / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const TriMesh frame = read_obj((dir_ / "out/skirt/frames/mesh_0001.obj").string());
+    ASSERT_EQ(frame.uv.size(), frame.triangles.size()) << "level " << level;
+    // Two pieces of 0.5 m x 0.5 m: their pattern area, whatever the refinement.
+    EXPECT_NEAR(uv_area(frame), 0.5, 1e-12) << "level " << level;
+    const auto summary = nlohmann::json::parse(testing::read_file_bytes(dir_ / "out/skirt/summary.json"));
+    ASSERT_TRUE(summary.contains("settle")) << summary.dump();
+    EXPECT_EQ(summary["settle"]["steps"], 5);
+    EXPECT_GT(summary["settle"]["membrane_strain_start"].get<double>(), summary["settle"]["membrane_strain_end"].get<double>());
+  }
+}
+
+}  // namespace
+}  // namespace clothsim
