@@ -1,5 +1,7 @@
 #include "app/limit_surface_drawer.hpp"
 
+#include "sim/subdivision/loop.hpp"
+
 #include "render/camera_math.hpp"
 
 #include <Eigen/Geometry>
@@ -45,6 +47,22 @@ LimitSurfaceDrawer::LimitSurfaceDrawer(const Discretization& discretization, con
   for (const auto& [a, b] : edges) {
     edges_.push_back(static_cast<unsigned>(a));
     edges_.push_back(static_cast<unsigned>(b));
+  }
+  // The checker: each fine triangle takes the square of its centroid's texture coordinates (its
+  // control triangle's, split as the triangle is).
+  const TriMesh& control = discretization.mesh();
+  if (settings.texture == "checker" && control.uv.size() == control.triangles.size() &&
+      display_.triangles.size() == control.uv.size() << (2 * display_.levels)) {
+    const std::vector<std::array<Eigen::Vector2d, 3>> uv = refine_corner_uv(control.uv, display_.levels);
+    std::vector<unsigned> light;
+    for (std::size_t t = 0; t < uv.size(); ++t) {
+      const Eigen::Vector2d c = (uv[t][0] + uv[t][1] + uv[t][2]) / (3.0 * RenderSettings::kCheckerCell);
+      const bool dark = ((static_cast<long long>(std::floor(c.x())) + static_cast<long long>(std::floor(c.y()))) & 1) != 0;
+      std::vector<unsigned>& into = dark ? checker_triangles_ : light;
+      into.insert(into.end(), triangles_.begin() + static_cast<std::ptrdiff_t>(3 * t),
+                  triangles_.begin() + static_cast<std::ptrdiff_t>(3 * t + 3));
+    }
+    triangles_ = std::move(light);
   }
   // The grain lines: through each triangle's centroid along its warp (projected into its plane),
   // 0.6 √(2 area) long.
@@ -161,6 +179,15 @@ render::Frame LimitSurfaceDrawer::frame(const SurfaceSnapshot& s, const render::
   mesh.color = to_vec3f(settings_.color);
   mesh.back_color = to_vec3f(settings_.back_color);
   f.meshes.push_back(std::move(mesh));
+  if (!checker_triangles_.empty()) {  // the darker squares: the same surface, 55 % of the colours
+    render::Mesh dark;
+    dark.positions = s.positions;
+    dark.normals = s.normals;
+    dark.triangles = checker_triangles_;
+    dark.color = to_vec3f(0.55 * settings_.color);
+    dark.back_color = to_vec3f(0.55 * settings_.back_color);
+    f.meshes.push_back(std::move(dark));
+  }
   if (settings_.wireframe && !s.control.empty()) {
     render::Lines lines;
     lines.positions = s.control;

@@ -63,6 +63,9 @@ class LimitSurfaceDrawer {
   // triangle; the line's end points move with the triangle's affine map. Empty without grain.
   std::vector<double> grain_coefficients_;
   std::vector<unsigned> grain_segments_;
+  // render.texture "checker": the fine triangles of the darker squares (drawn as a second mesh;
+  // triangles_ then holds the others).
+  std::vector<unsigned> checker_triangles_;
   RenderSettings settings_;
   int width_, height_;
   std::vector<Obstacle> obstacles_;    // drawn meshes (no planes)

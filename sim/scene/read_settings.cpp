@@ -340,7 +340,7 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   colour("back_color", s.back_color);
   colour("background", s.background);
   if (const Json* v = r.find(*j, "wireframe")) s.wireframe = r.boolean(*v, "render.wireframe");
-  if (const Json* v = r.find(*j, "texture")) s.texture = r.choice(*v, "render.texture", {"none", "grain"}, "texture");
+  if (const Json* v = r.find(*j, "texture")) s.texture = r.choice(*v, "render.texture", {"none", "grain", "checker"}, "texture");
   if (const Json* v = r.find(*j, "ground")) s.ground = r.boolean(*v, "render.ground");
   if (const Json* v = r.find(*j, "surface")) {
     const std::string surface = r.choice(*v, "render.surface", {"method", "loop_limit", "flat"}, "surface");

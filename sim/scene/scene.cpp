@@ -568,6 +568,9 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   std::optional<SewnPattern> pattern;
   TriMesh mesh = build_mesh(r, mesh_json, file.parent_path(), say, max_vertices, grain,
                             grain.given || scene.problem.material.orthotropic() || draw_grain, pattern);
+  if (scene.render.texture == "checker" && mesh.uv.size() != mesh.triangles.size())
+    r.fail("render.texture", "\"checker\" needs texture coordinates on the mesh (a pattern garment, or an OBJ with vt "
+                             "on every face)");
   // "rest": the elements' rest state (sim/shell/flat_rest.hpp); a pattern garment rests flat.
   scene.problem.rest = pattern ? RestShape::pattern : RestShape::initial;
   if (const Json* rest = r.find(root, "rest"))

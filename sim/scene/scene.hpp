@@ -53,8 +53,11 @@ struct RenderSettings {
   bool wireframe = false;  // overlay the control mesh
   // "render.texture": "none", or "grain": a short line along the (deformed) warp direction across
   // every control triangle, so that a picture shows how the cloth is cut (the grain of
-  // material.grain, warp_deg 0 by default; an OBJ mesh needs texture coordinates for it).
+  // material.grain, warp_deg 0 by default; an OBJ mesh needs texture coordinates for it), or
+  // "checker": squares of kCheckerCell on the texture coordinates (a pattern's, in metres), every
+  // other one darker, so that the pieces' layout and their stretching read at a glance.
   std::string texture = "none";
+  static constexpr double kCheckerCell = 0.05;  // [texture units: m for a pattern] side of a checker square
   bool ground = false;     // a ground plane at the bottom of the framed box (see `framing`)
   bool has_camera = false;  // otherwise framed automatically, see `framing`
   Eigen::Vector3d eye{0, 0, 1}, target{0, 0, 0}, up{0, 1, 0};  // [m]

@@ -51,3 +51,39 @@ TEST(GrainLines, RunAlongTheWarpAndFollowTheDeformation) {
 
 }  // namespace
 }  // namespace clothsim
+
+namespace clothsim {
+namespace {
+
+// render.texture "checker": squares of RenderSettings::kCheckerCell on the texture coordinates,
+// the darker ones drawn as a second mesh over the same points.
+TEST(CheckerTexture, SplitsTheFineTrianglesBySquare) {
+  // A 0.2 m x 0.1 m grid whose texture coordinates are its own x, y in metres: 4 x 2 squares of
+  // 5 cm, every other one dark, so half of the surface's area is dark.
+  TriMesh mesh = make_grid(0.2, 0.1, 8, 4);
+  for (const Triangle& t : mesh.triangles) {
+    std::array<Eigen::Vector2d, 3> c;
+    for (int k = 0; k < 3; ++k) c[static_cast<size_t>(k)] = mesh.vertices.row(t[static_cast<size_t>(k)]).head<2>().transpose();
+    mesh.uv.push_back(c);
+  }
+  const LoopShellDiscretization d(mesh, {}, ShellMaterial{}, Quadrature::one_point);
+  RenderSettings settings;
+  settings.refine = 1;
+  settings.texture = "checker";
+  const LimitSurfaceDrawer drawer(d, settings, 64, 48);
+  const render::Frame f = drawer.frame(drawer.snapshot(d.rest()), render::Camera{}, 0.0f);
+  ASSERT_EQ(f.meshes.size(), 2u);
+  const std::size_t light = f.meshes[0].triangles.size() / 3, dark = f.meshes[1].triangles.size() / 3;
+  EXPECT_EQ(light + dark, 4 * mesh.triangles.size());
+  EXPECT_EQ(light, dark);  // the grid's cells never straddle a square: exactly half each
+  EXPECT_LT(f.meshes[1].color[0], f.meshes[0].color[0]);
+  // Without texture coordinates the checker is not drawn (the scene loader refuses it before).
+  TriMesh bare = mesh;
+  bare.uv.clear();
+  const LoopShellDiscretization plain(bare, {}, ShellMaterial{}, Quadrature::one_point);
+  const LimitSurfaceDrawer no_uv(plain, settings, 64, 48);
+  EXPECT_EQ(no_uv.frame(no_uv.snapshot(plain.rest()), render::Camera{}, 0.0f).meshes.size(), 1u);
+}
+
+}  // namespace
+}  // namespace clothsim

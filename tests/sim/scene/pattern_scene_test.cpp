@@ -99,6 +99,8 @@ TEST_F(PatternScene, ErrorsNameTheKey) {
   EXPECT_TRUE(contains(error(R"({"analysis": "dynamic", )" + std::string(kSkirt) +
                              R"(, "material": {"preset": "cotton_broadcloth_ortho", "grain": {"warp_deg": 10}}})"),
                        "material.grain: a pattern mesh takes its grain from its pieces"));
+  EXPECT_TRUE(contains(error(R"({"mesh": {"primitive": "grid", "size": [0.2, 0.1], "divisions": [4, 2]}, "render": {"texture": "checker"}})"),
+                       "render.texture: \"checker\" needs texture coordinates on the mesh"));
   // The builder's errors come back under the pattern's key.
   std::string bad = dynamic("");
   bad.replace(bad.find("[0.25, 0.5], [-0.25, 0.5]]"), 26, "[0.25, 0.48], [-0.25, 0.48]]");
