@@ -119,7 +119,7 @@ TEST(FlatRest, APieceWrappedOntoACylinderSpringsBackFlat) {
     const Eigen::MatrixX3d x = sim.state().positions();
     const Eigen::RowVector3d c = x.colwise().mean();
     const Eigen::MatrixX3d d = x.rowwise() - c;
-    const Eigen::JacobiSVD<Eigen::MatrixX3d> svd(d, Eigen::ComputeThinV);
+    const Eigen::JacobiSVD<Eigen::MatrixX3d> svd(d, Eigen::ComputeFullV);  // (V is 3 x 3)
     return (d * svd.matrixV().col(2)).cwiseAbs().maxCoeff();
   };
   const double start = bow();
