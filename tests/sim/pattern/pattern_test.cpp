@@ -98,6 +98,14 @@ void expect_isolated_irregular(const TriMesh& mesh) {
   for (const Triangle& t : mesh.triangles) ASSERT_LE(irregular_vertex_count(ext, t), 1);
 }
 
+// A tube (an annulus): manifold, two boundary loops, Euler characteristic 0.
+void expect_tube(const TriMesh& mesh) {
+  const Topology topology(mesh.num_vertices(), mesh.triangles);
+  EXPECT_EQ(topology.boundary_loops().size(), 2u);
+  const long euler = static_cast<long>(mesh.num_vertices()) - static_cast<long>(edges_of(mesh).size()) + mesh.num_triangles();
+  EXPECT_EQ(euler, 0);
+}
+
 TEST(BuildPattern, SquarePiece) {
   PatternSpec spec;
   spec.edge_length = 0.05;
@@ -186,11 +194,7 @@ TEST(BuildPattern, TubeFromOneRectangle) {
   spec.seams.push_back({{"tube", 1, 1}, {"tube", 3, 3}, true});
   const PatternMesh out = build_pattern(spec);
   const TriMesh& mesh = out.mesh;
-  const Topology topology(mesh.num_vertices(), mesh.triangles);
-  EXPECT_EQ(topology.boundary_loops().size(), 2u);
-  // A tube (annulus): Euler characteristic 0.
-  const long euler = static_cast<long>(mesh.num_vertices()) - static_cast<long>(edges_of(mesh).size()) + mesh.num_triangles();
-  EXPECT_EQ(euler, 0);
+  expect_tube(mesh);
   ASSERT_EQ(out.seam_gap.size(), 1u);
   EXPECT_LT(out.seam_gap[0], 1e-9 * r);
   for (int v = 0; v < mesh.num_vertices(); ++v) {
@@ -214,10 +218,7 @@ TEST(BuildPattern, TwoPieceSkirt) {
   const PatternSpec spec = skirt(0.02);
   const PatternMesh out = build_pattern(spec);
   const TriMesh& mesh = out.mesh;
-  const Topology topology(mesh.num_vertices(), mesh.triangles);
-  EXPECT_EQ(topology.boundary_loops().size(), 2u);
-  const long euler = static_cast<long>(mesh.num_vertices()) - static_cast<long>(edges_of(mesh).size()) + mesh.num_triangles();
-  EXPECT_EQ(euler, 0);
+  expect_tube(mesh);
   expect_outward(mesh);
   expect_isolated_irregular(mesh);
 
