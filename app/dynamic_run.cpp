@@ -196,7 +196,9 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, const Sett
     j["settle"] = {{"time", scene.problem.settle.time},
                    {"steps", settle.steps},
                    {"membrane_strain_start", settle.strain_start},
-                   {"membrane_strain_end", settle.strain_end}};
+                   {"membrane_strain_end", settle.strain_end},
+                   {"seam_gap_start", settle.gap_start},
+                   {"seam_gap_end", settle.gap_end}};
   if (scene.problem.has_contact())
     j["contact"] = {{"pairs_tested", totals.contact.pairs_tested},
                     {"impulses", totals.contact.impulses},
@@ -534,7 +536,8 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
     log_line("settled for " + format_short(scene.problem.settle.time) + " s (" + std::to_string(settle.steps) +
              " steps, loads off, obstacles held, no pins): largest membrane strain " +
              format_short(100 * settle.strain_start) + " % at the start, " + format_short(100 * settle.strain_end) +
-             " % at the end");
+             " % at the end; largest seam gap (a control edge longer than in the pattern) " +
+             format_short(settle.gap_start) + " m at the start, " + format_short(settle.gap_end) + " m at the end");
   }
   // The renderer and the refinement operator, also before any file is written.
   std::unique_ptr<LimitSurfaceDrawer> drawer;

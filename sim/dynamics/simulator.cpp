@@ -105,6 +105,20 @@ struct Simulator::Impl {
 
 namespace {
 
+// The largest excess of a control edge's length at `x` (#V × 3) over its length in the texture
+// coordinates (the pattern) [m]; 0 without texture coordinates.
+double largest_seam_gap(const TriMesh& mesh, const Eigen::MatrixX3d& x) {
+  if (mesh.uv.size() != mesh.triangles.size()) return 0.0;
+  double gap = 0.0;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int a = mesh.triangles[t][k], b = mesh.triangles[t][(k + 1) % 3];
+      const double rest = (mesh.uv[t][(k + 1) % 3] - mesh.uv[t][k]).norm();
+      gap = std::max(gap, (x.row(a) - x.row(b)).norm() - rest);
+    }
+  return gap;
+}
+
 // The settling phase (Simulator's constructor): the problem with the loads off, the obstacles
 // held, no boundary conditions, strong mass damping, run for settle.time from rest; returns the
 // problem whose mesh starts where the settling ended.
@@ -128,10 +142,12 @@ Problem settled(const Problem& p, SettleReport& report) {
   try {
     Simulator sim(s);
     report.strain_start = sim.max_membrane_strain();
+    report.gap_start = largest_seam_gap(p.mesh, p.mesh.vertices);
     report.steps = sim.num_steps();
     for (int k = 0; k < report.steps; ++k) sim.step();
     report.strain_end = sim.max_membrane_strain();
     out.mesh.vertices = sim.state().positions();
+    report.gap_end = largest_seam_gap(p.mesh, out.mesh.vertices);
   } catch (const std::exception& e) {
     throw std::runtime_error("while settling (the " + std::to_string(p.settle.time) + " s before t = 0): " + e.what());
   }

@@ -36,6 +36,10 @@ struct SettleReport {
   int steps = 0;
   double strain_start = 0.0;  // [-]
   double strain_end = 0.0;    // [-]
+  // The largest seam gap: how much longer than in the pattern (its texture coordinates) a control
+  // edge is, at most — an open seam is a band of edges stretched across the gap [m]; 0 without
+  // texture coordinates.
+  double gap_start = 0.0, gap_end = 0.0;
 };
 
 class Simulator {

@@ -116,6 +116,11 @@ TEST_F(PatternScene, AnOpenSkirtSettlesClosed) {
   EXPECT_GT(sim.settle_report().strain_start, 1.0);
   EXPECT_LT(sim.settle_report().strain_end, 1e-3);
   EXPECT_EQ(sim.settle_report().steps, 100);
+  // The seam gap: at the start the band across each 3.4 cm gap is a control edge about 1.7 cm
+  // longer than in the pattern (each side moved half the gap); closed to below 0.1 mm.
+  EXPECT_GT(sim.settle_report().gap_start, 0.012);
+  EXPECT_LT(sim.settle_report().gap_start, 0.034);
+  EXPECT_LT(sim.settle_report().gap_end, 1e-4);
   // The run starts at rest where the settling ended.
   EXPECT_EQ(sim.state().v.cwiseAbs().maxCoeff(), 0.0);
   EXPECT_LT(sim.max_membrane_strain(), 1e-3);
