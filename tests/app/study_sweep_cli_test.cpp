@@ -116,7 +116,10 @@ TEST_F(StudySweepCli, LocalJobsAndPlanTaskGatherGiveTheSerialResults) {
   const CliResult local = run(std::string(kPlan) + " -j 2 --out " + q(dir_ / "local"));
   ASSERT_EQ(local.exit_code, 0) << local.err;
   EXPECT_TRUE(contains(local.out, "local: 4 tasks in")) << local.out;
-  EXPECT_TRUE(contains(local.out, "at most 2 at once")) << local.out;
+  // The limit is what -j asked for; how many tasks the log shows overlapping depends on the
+  // scheduler (tasks of 0.1 s on a loaded machine may run one after another), but never above 2.
+  EXPECT_TRUE(contains(local.err, "4 of 4 tasks to run (local, 2 at once;")) << local.err;
+  EXPECT_TRUE(contains(local.out, "at most 1 at once") || contains(local.out, "at most 2 at once")) << local.out;
   EXPECT_EQ(without_times(read_file_bytes(dir_ / "local" / "study_folds" / "results.csv")), expected);
   EXPECT_TRUE(fs::exists(dir_ / "local" / "study_folds.tasks" / "logs" / "task_3.log"));
   // Again: the usual folder of the previous sweep is replaced, not resumed.
