@@ -30,6 +30,14 @@ std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& 
   return missing;
 }
 
+void check_folder_possible(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::path p = dir;
+  while (!p.empty() && !std::filesystem::exists(p, ec) && p != p.parent_path()) p = p.parent_path();
+  if (!p.empty() && std::filesystem::exists(p, ec) && !std::filesystem::is_directory(p, ec))
+    throw std::runtime_error(dir.string() + ": cannot be a folder, " + p.string() + " is not a folder");
+}
+
 void write_text_file(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;

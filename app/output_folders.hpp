@@ -11,6 +11,11 @@ namespace clothsim {
 // would make; used to remove exactly those again when a run fails.
 std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& dir);
 
+// Throws std::runtime_error naming the path when `dir` cannot become a folder: it, or the nearest
+// of its ancestors that exists, is not a folder. Lets a long study refuse an unusable --out before
+// it runs anything.
+void check_folder_possible(const std::filesystem::path& dir);
+
 // Writes `text` to `path` (binary, replacing the file); throws std::runtime_error naming the path
 // when the file cannot be written.
 void write_text_file(const std::filesystem::path& path, const std::string& text);

@@ -725,6 +725,12 @@ int run_study_command(const std::string& name, const std::function<SweepStudy()>
     return 1;
   }
   const std::optional<fs::path> out_root = c.out_given ? std::optional<fs::path>(c.out_root) : std::nullopt;
+  try {
+    if (out_root || !c.gather) check_folder_possible(c.out_root);  // before any case runs
+  } catch (const std::exception& e) {
+    std::cerr << "clothsim: error: study " << name << ": --out " << e.what() << '\n';
+    return 1;
+  }
   if (c.gather) {
     try {
       const SweepPlan plan = read_sweep_plan(*c.gather);

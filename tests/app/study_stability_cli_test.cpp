@@ -99,6 +99,8 @@ TEST_F(StudyStabilityCli, UnusableOutputRootIsAnErrorAndWritesNothing) {
   std::ofstream(file) << "not a folder";
   EXPECT_EQ(study(file / "sub", "--no-plot"), 1);
   EXPECT_NE(err_.find("clothsim: error: "), std::string::npos) << err_;
+  EXPECT_NE(err_.find(file.string() + " is not a folder"), std::string::npos) << err_;
+  EXPECT_EQ(err_.find("[1/"), std::string::npos) << "a case ran before the error: " << err_;
   EXPECT_EQ(read_file_bytes(file), "not a folder");
 }
 
