@@ -178,6 +178,7 @@ void cusick_part(const FabricUnderTest& f, const FabricTestOptions& o, const fs:
   s.rings = o.rings;
   s.end = o.cusick_end;
   s.imperfection = o.imperfection;
+  s.ramp = o.cusick_ramp;
   const fs::path runs = dir / "runs";
   struct Level {
     int rings = 0, vertices = 0;
@@ -194,7 +195,7 @@ void cusick_part(const FabricUnderTest& f, const FabricTestOptions& o, const fs:
     Json scene = cusick_scene(f, name + ".obj", s);
     scene["name"] = name;
     say("Cusick drape, " + std::to_string(rings) + " rings (" + std::to_string(l.vertices) + " vertices), " +
-        fixed(s.end, 2) + " s");
+        (s.ramp > 0 ? "gravity ramped in over " + fixed(s.ramp, 2) + " s, then " : std::string()) + fixed(s.end, 2) + " s");
     const auto t0 = std::chrono::steady_clock::now();
     const fs::path run = run_scene(scene, runs, o);
     l.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -221,7 +222,9 @@ void cusick_part(const FabricUnderTest& f, const FabricTestOptions& o, const fs:
   rep.rows.push_back({"cusick", "nodes", "-", 0, static_cast<double>(fine.m.nodes), std::nullopt, measured_nodes});
   rep.md << "## Cusick drape (ISO 9073-9)\n\n"
          << "A disc of " << fixed(2 * s.specimen_radius * 100, 0) << " cm on a support disc of "
-         << fixed(2 * s.support_radius * 100, 0) << " cm, " << fixed(s.end, 2) << " s under gravity (dt " << s.dt
+         << fixed(2 * s.support_radius * 100, 0) << " cm, "
+         << (s.ramp > 0 ? "gravity ramped in over " + fixed(s.ramp, 2) + " s, then " : std::string()) << fixed(s.end, 2)
+         << " s under gravity (dt " << s.dt
          << " s, self-collision, contact thickness " << s.thickness * 1000 << " mm"
          << (s.imperfection > 0 ? ", seeded imperfection " + fixed(s.imperfection * 1000, 2) + " mm" : std::string())
          << "), on meshes of increasing refinement. DC = (A_shadow − A_support) / (A_specimen − A_support) from the vertical projection of the "
@@ -287,6 +290,7 @@ int run_fabric_test(const FabricTestOptions& o) {
       if (o.rings[i] < 2 || o.rings[i] > 200 || (i > 0 && o.rings[i] <= o.rings[i - 1]))
         throw std::invalid_argument("--rings: expected increasing ring counts between 2 and 200");
     if (!(o.cusick_end > 0) || o.cusick_end > 60) throw std::invalid_argument("--end: expected 0 < T <= 60 s");
+    if (!(o.cusick_ramp >= 0) || o.cusick_ramp > 60) throw std::invalid_argument("--ramp: expected 0 <= T <= 60 s");
     if (!(o.imperfection >= 0) || o.imperfection > 0.01)
       throw std::invalid_argument("--imperfection: expected 0 <= A <= 0.01 m");
     const FabricUnderTest f = fabric_under_test(o.target);

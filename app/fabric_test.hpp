@@ -17,6 +17,7 @@ struct FabricTestOptions {
   std::filesystem::path out_root = "out";
   std::vector<int> rings = {16, 24, 32};          // Cusick meshes, coarse to fine
   double cusick_end = 3.0;                        // [s]
+  double cusick_ramp = 0.0;                       // Cusick: gravity ramped in over this time [s] (0: at once)
   double imperfection = 0.0;                      // Cusick: seeded imperfection amplitude [m] (0: none)
   bool quick = false;                             // coarse and short (seconds; for tests)
   bool render = true;

@@ -356,6 +356,11 @@ int fabric_test_command(int argc, char** argv) {
   app.add_option("--rings", rings, "Cusick meshes as disc ring counts, coarse to fine (default 16,24,32)")
       ->type_name("N,N,...");
   app.add_option("--end", options.cusick_end, "Cusick: simulated time [s]")->type_name("T")->capture_default_str();
+  app.add_option("--ramp", options.cusick_ramp,
+                 "Cusick: gravity grows from zero over T s (the specimen lowered slowly), then --end more seconds; "
+                 "0: the full weight at once")
+      ->type_name("T")
+      ->capture_default_str();
   app.add_option("--imperfection", options.imperfection,
                  "Cusick: a seeded imperfection of the specimen, largest normal offset A [m] (scene key imperfection)")
       ->type_name("A")

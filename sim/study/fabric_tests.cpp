@@ -310,8 +310,8 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
       // that it starts clear of the support.
       {"mesh", {{"obj", disc_file}, {"translate", {0, h + s.imperfection, 0}}}},
       {"material", with_grain(fabric, 0.0)},
-      {"loads", {{"gravity", {0, -kGravity, 0}}}},
-      {"time", {{"dt", s.dt}, {"end", s.end}, {"output_fps", 4.0 / s.end}}},  // frames at every quarter
+      {"loads", {{"gravity", {0, -kGravity, 0}}, {"ramp_time", s.ramp}}},
+      {"time", {{"dt", s.dt}, {"end", s.ramp + s.end}, {"output_fps", 4.0 / (s.ramp + s.end)}}},  // frames at every quarter
       {"damping", {{"stiffness", 0.001}, {"mass", 1.0}}},
       {"collision", {{"self", true}, {"thickness", s.thickness}, {"friction", 0.3}}},
       {"obstacles",

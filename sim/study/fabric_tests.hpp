@@ -134,6 +134,9 @@ struct CusickSettings {
   double dt = 0.002;           // [s]
   double thickness = 0.001;    // contact thickness [m]
   double imperfection = 0.0;   // [m] a seeded imperfection of the specimen (scene key imperfection, seed 1); 0: none
+  // [s] gravity grows linearly from zero over this time (loads.ramp_time), the specimen lowered
+  // slowly onto its drape; the run lasts ramp + end. 0: the full weight at once (a drop).
+  double ramp = 0.0;
 };
 // The specimen: a disc of `rings` rings (1 + 3N(N+1) vertices, ring k of 6k), in the x–z plane
 // with normal +y, texture coordinates u = (x/R + 1)/2, v = (1 − z/R)/2 (warp along +x).

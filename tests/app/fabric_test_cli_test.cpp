@@ -82,6 +82,7 @@ TEST(FabricTestCli, BadInputNamesTheProblemAndWritesNothing) {
   fails_with("cotton --rings 24,16", "--rings");
   fails_with("cotton --rings 16,x", "--rings");
   fails_with("cotton --imperfection -0.001", "--imperfection");
+  fails_with("cotton --ramp -1", "--ramp");
   fails_with(shell_quote((tmp / "missing.json").string()), "missing.json");
   fs::remove_all(tmp);
 }

@@ -124,6 +124,25 @@ TEST(FabricTest, CusickSpecimenStartsClearOfTheSupport) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(FabricTest, CusickRampLowersTheSpecimenAndThenRunsTheEndTime) {
+  // --ramp T: gravity grows over T s (loads.ramp_time), and the drape then has `end` s more.
+  const FabricUnderTest f = fabric_under_test("cotton_broadcloth_ortho");
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "clothsim_cusick_ramp_test";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "disc.obj") << disc_obj(0.15, 4);
+  CusickSettings s;
+  s.ramp = 2.0;
+  s.end = 3.0;
+  const Scene ramped = load_scene_text(cusick_scene(f, "disc.obj", s).dump(), dir / "cusick.json", {});
+  EXPECT_DOUBLE_EQ(ramped.problem.ramp_time, 2.0);
+  EXPECT_DOUBLE_EQ(ramped.problem.time.end, 5.0);
+  s.ramp = 0.0;
+  const Scene dropped = load_scene_text(cusick_scene(f, "disc.obj", s).dump(), dir / "cusick.json", {});
+  EXPECT_DOUBLE_EQ(dropped.problem.ramp_time, 0.0);
+  EXPECT_DOUBLE_EQ(dropped.problem.time.end, 3.0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(FabricTest, MaterialFromPresetAndMeasurements) {
   const FabricUnderTest f = fabric_under_test("polyester_faille_ortho");
   ASSERT_TRUE(f.law.orthotropic());
