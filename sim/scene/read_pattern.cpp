@@ -36,17 +36,22 @@ PatternPlacement read_placement(const Reader& r, const Json& j, const std::strin
 
 }  // namespace
 
+std::size_t read_piece_name(const Reader& r, const Json& j, const std::string& path, const PatternSpec& spec) {
+  const std::string name = r.string(j, path);
+  std::vector<std::string> names;
+  for (const PatternPiece& p : spec.pieces) names.push_back(p.name);
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end())
+    r.fail(path, "no piece " + quote(name) + " (pieces: " + format_list(names, true) + ")" + did_you_mean(name, names));
+  return static_cast<std::size_t>(it - names.begin());
+}
+
 SeamSide read_piece_edge(const Reader& r, const Json& j, const std::string& path, const PatternSpec& spec) {
   r.check_object(j, path, {"piece", "edge"});
   SeamSide side;
-  side.piece = r.string(r.require(j, path, "piece"), join_key(path, "piece"));
-  std::vector<std::string> names;
-  for (const PatternPiece& p : spec.pieces) names.push_back(p.name);
-  const auto it = std::find(names.begin(), names.end(), side.piece);
-  if (it == names.end())
-    r.fail(join_key(path, "piece"), "no piece " + quote(side.piece) + " (pieces: " + format_list(names, true) + ")" +
-                                        did_you_mean(side.piece, names));
-  const PatternPiece& piece = spec.pieces[static_cast<size_t>(it - names.begin())];
+  const std::size_t index = read_piece_name(r, r.require(j, path, "piece"), join_key(path, "piece"), spec);
+  side.piece = spec.pieces[index].name;
+  const PatternPiece& piece = spec.pieces[index];
   const std::string ep = join_key(path, "edge");
   const Json& edge = r.require(j, path, "edge");
   if (edge.is_array()) {

@@ -12,6 +12,10 @@ namespace clothsim::scene_io {
 
 PatternSpec read_pattern(const Reader& r, const Json& j, const std::string& path);
 
+// The index in `spec` of the piece named by the string `j` (an error at `path` listing the pieces
+// otherwise).
+std::size_t read_piece_name(const Reader& r, const Json& j, const std::string& path, const PatternSpec& spec);
+
 // A seam side or a piece edge named in a scene: {"piece": name, "edge": i} or
 // {"piece": name, "edge": [first, last]} (a path of consecutive edges), checked against `spec`
 // (the piece exists, the edges are in range).

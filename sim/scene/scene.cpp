@@ -67,14 +67,52 @@ void check_travel(const Reader& r, const Motion& m, const std::string& path, con
 // closed box (at least one).
 // A boundary's or a load's "select": {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} (the
 // vertices inside it) or, on a pattern garment, {"piece_edge": {"piece": name, "edge": i or
-// [first, last]}} (the vertices along the piece's edge or path of edges).
+// [first, last]}} (the vertices along the piece's edge or path of edges) or {"piece": {"name":
+// name, "box": [[umin, vmin], [umax, vmax]]}} (the piece's vertices, those whose pattern
+// coordinates lie in the closed box if one is given: a vertex group drawn on the pattern).
 std::vector<int> read_selection(const Reader& r, const Json& item, const std::string& path, const TriMesh& mesh,
                                 const SewnPattern* pattern) {
   const std::string select_path = join_key(path, "select");
   const Json& select = r.require(item, path, "select");
-  r.check_object(select, select_path, {"box", "piece_edge"});
-  if (select.contains("box") == select.contains("piece_edge"))
-    r.fail(select_path, "give one of \"box\" and \"piece_edge\"");
+  r.check_object(select, select_path, {"box", "piece_edge", "piece"});
+  if (select.contains("box") + select.contains("piece_edge") + select.contains("piece") != 1)
+    r.fail(select_path, "give one of \"box\", \"piece_edge\" and \"piece\"");
+  if (const Json* region = r.find(select, "piece")) {
+    const std::string region_path = join_key(select_path, "piece");
+    if (pattern == nullptr) r.fail(region_path, "needs a pattern mesh (\"mesh\": {\"pattern\": ...})");
+    r.check_object(*region, region_path, {"name", "box"});
+    const std::size_t piece = read_piece_name(r, r.require(*region, region_path, "name"), join_key(region_path, "name"),
+                                              pattern->spec);
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(-std::numeric_limits<double>::infinity()), hi = -lo;
+    const std::string box_path = join_key(region_path, "box");
+    if (const Json* box = r.find(*region, "box")) {
+      if (!box->is_array() || box->size() != 2)
+        r.fail(box_path, "expected an array of 2 points [[umin, vmin], [umax, vmax]] in the piece's pattern coordinates [m] "
+                         "(got " + describe(*box) + ")");
+      for (int c = 0; c < 2; ++c) {
+        const std::string corner = join_index(box_path, c);
+        const Json& p = (*box)[static_cast<std::size_t>(c)];
+        if (!p.is_array() || p.size() != 2) r.fail(corner, "expected [u, v] [m] (got " + describe(p) + ")");
+        (c == 0 ? lo : hi) = Eigen::Vector2d(r.number(p[0], join_index(corner, 0)), r.number(p[1], join_index(corner, 1)));
+      }
+      for (int k = 0; k < 2; ++k)
+        if (lo[k] > hi[k]) r.fail(box_path, "min must be <= max in u and v (got " + format_number(lo[k]) + " > " + format_number(hi[k]) + ")");
+    }
+    const PatternMesh& built = pattern->built;
+    std::vector<int> vertices;
+    for (std::size_t t = 0; t < built.triangle_piece.size(); ++t) {
+      if (built.triangle_piece[t] != static_cast<int>(piece)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const Eigen::Vector2d& uv = built.mesh.uv[t][static_cast<std::size_t>(c)];
+        if ((uv.array() >= lo.array()).all() && (uv.array() <= hi.array()).all())
+          vertices.push_back(built.mesh.triangles[t][static_cast<std::size_t>(c)]);
+      }
+    }
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    if (vertices.empty()) r.fail(box_path, "selects no vertex of piece " + quote(pattern->spec.pieces[piece].name));
+    return vertices;
+  }
   if (const Json* edge = r.find(select, "piece_edge")) {
     const std::string edge_path = join_key(select_path, "piece_edge");
     if (pattern == nullptr) r.fail(edge_path, "needs a pattern mesh (\"mesh\": {\"pattern\": ...})");

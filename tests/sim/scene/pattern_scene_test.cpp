@@ -12,7 +12,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <iterator>
 #include <string>
+#include <vector>
 
 namespace clothsim {
 namespace {
@@ -80,6 +83,39 @@ TEST_F(PatternScene, ABoundaryCanSelectAPiecesEdge) {
   EXPECT_EQ(s.problem.boundary[1].vertices.size(), 3u * 27u - 2u);
 }
 
+TEST_F(PatternScene, ABoundaryCanSelectAVertexGroupDrawnOnThePattern) {
+  const Scene s = load(dynamic(R"(, "boundary": [
+    {"select": {"piece": {"name": "front"}}, "fix": ["x"]},
+    {"select": {"piece": {"name": "back"}}, "fix": ["x"]},
+    {"select": {"piece_edge": {"piece": "front", "edge": 1}}, "fix": ["x"]},
+    {"select": {"piece_edge": {"piece": "front", "edge": 3}}, "fix": ["x"]},
+    {"select": {"piece": {"name": "front", "box": [[-0.3, 0.45], [0.3, 0.6]]}}, "fix": ["x", "y", "z"]},
+    {"select": {"piece_edge": {"piece": "front", "edge": 2}}, "fix": ["x"]}])"));
+  ASSERT_EQ(s.problem.boundary.size(), 6u);
+  const auto& b = s.problem.boundary;
+  // The two pieces cover the mesh and share exactly the front's two sewn sides.
+  std::vector<int> both, all;
+  std::set_intersection(b[0].vertices.begin(), b[0].vertices.end(), b[1].vertices.begin(), b[1].vertices.end(),
+                        std::back_inserter(both));
+  std::set_union(b[0].vertices.begin(), b[0].vertices.end(), b[1].vertices.begin(), b[1].vertices.end(),
+                 std::back_inserter(all));
+  std::vector<int> sides;
+  std::set_union(b[2].vertices.begin(), b[2].vertices.end(), b[3].vertices.begin(), b[3].vertices.end(),
+                 std::back_inserter(sides));
+  EXPECT_EQ(both, sides);
+  EXPECT_EQ(static_cast<int>(all.size()), s.problem.mesh.num_vertices());
+  // The band v >= 0.45 m of the front: placed from y = 0.9 to 0.95 (the piece's top at v = 0.5
+  // is placed at y = 0.95), its top edge included, nothing of the back but the sewn corners.
+  ASSERT_FALSE(b[4].vertices.empty());
+  for (const int v : b[4].vertices) {
+    EXPECT_GE(s.problem.mesh.vertices(v, 1), 0.9 - 1e-9);
+    EXPECT_LE(s.problem.mesh.vertices(v, 1), 0.95 + 1e-9);
+    EXPECT_TRUE(std::binary_search(b[0].vertices.begin(), b[0].vertices.end(), v));
+  }
+  EXPECT_TRUE(std::includes(b[4].vertices.begin(), b[4].vertices.end(), b[5].vertices.begin(), b[5].vertices.end()));
+  EXPECT_GT(b[4].vertices.size(), 2 * b[5].vertices.size());  // more than one row
+}
+
 TEST_F(PatternScene, ErrorsNameTheKey) {
   EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece_edge": {"piece": "frnot", "edge": 2}}, "fix": ["x"]}])")),
                        "boundary[0].select.piece_edge.piece: no piece \"frnot\" (pieces: \"front\", \"back\"); did you mean \"front\"?"));
@@ -89,7 +125,18 @@ TEST_F(PatternScene, ErrorsNameTheKey) {
       "boundary": [{"select": {"piece_edge": {"piece": "front", "edge": 0}}, "fix": ["x"]}]})"),
                        "boundary[0].select.piece_edge: needs a pattern mesh"));
   EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"box": [[-1, -1, -1], [1, 1, 1]], "piece_edge": {"piece": "front", "edge": 0}}, "fix": ["x"]}])")),
-                       "boundary[0].select: give one of \"box\" and \"piece_edge\""));
+                       "boundary[0].select: give one of \"box\", \"piece_edge\" and \"piece\""));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece": {"name": "fornt"}}, "fix": ["x"]}])")),
+                       "boundary[0].select.piece.name: no piece \"fornt\""));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece": {"name": "front", "box": [[1, 1], [2, 2]]}}, "fix": ["x"]}])")),
+                       "boundary[0].select.piece.box: selects no vertex of piece \"front\""));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece": {"name": "front", "box": [[1, 1]]}}, "fix": ["x"]}])")),
+                       "boundary[0].select.piece.box: expected an array of 2 points"));
+  EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece": {"name": "front", "box": [[1, 1], [0, 2]]}}, "fix": ["x"]}])")),
+                       "boundary[0].select.piece.box: min must be <= max"));
+  EXPECT_TRUE(contains(error(R"({"analysis": "dynamic", "mesh": {"primitive": "grid", "size": [0.2, 0.1], "divisions": [4, 2]},
+      "boundary": [{"select": {"piece": {"name": "front"}}, "fix": ["x"]}]})"),
+                       "boundary[0].select.piece: needs a pattern mesh"));
   EXPECT_TRUE(contains(error(dynamic(R"(, "rest": "initial", "settle": {"time": 0.5})")),
                        "settle: needs a rest state of its own (\"rest\": \"pattern\")"));
   EXPECT_TRUE(contains(error(dynamic(R"(, "settle": {"time": -1})")), "settle.time: must be >= 0 [s]"));

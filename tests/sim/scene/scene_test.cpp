@@ -154,7 +154,7 @@ TEST_F(SceneLoader, UnknownKeysAtAnyLevel) {
                        expected("mesh.radius: unknown key (allowed: primitive, size, divisions, rotate, translate, max_vertices, fit_limit)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 +
                              R"(, "boundary": [{"select": {"box": [[0, 0, 0], [1, 1, 1]], "sphere": 1}}]})"),
-                       expected("boundary[0].select.sphere: unknown key (allowed: box, piece_edge)")));
+                       expected("boundary[0].select.sphere: unknown key (allowed: box, piece_edge, piece)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "probes": [{"name": "a", "at": [0, 0, 0], "x": 1}]})"),
                        expected("probes[0].x: unknown key (allowed: name, at)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "numerics": {"solver": "cg"}})"),

@@ -210,6 +210,7 @@ const std::vector<Place>& places() {
       {"piece_edge", "every pattern key", "/mesh/pattern/seams/0/a", "mesh.pattern.seams[0].a"},
       {"settle", "every pattern key", "/settle", "settle"},
       {"half_space", "obj obstacle part", "/obstacles/0/keep/0", "obstacles[0].keep[0]"},
+      {"piece_region", "pattern vertex group", "/boundary/0/select/piece", "boundary[0].select.piece"},
   };
   return p;
 }
