@@ -16,6 +16,7 @@
 namespace clothsim {
 namespace {
 
+using check::closest_vertex_distance;
 using check::intersections;
 using check::IntersectionReport;
 using check::self_intersections;
@@ -315,6 +316,35 @@ TEST(SurfaceIntersections, SphereAgainstGrids) {
   // The other way round, the same counts.
   EXPECT_EQ(intersections(through, sphere).intersecting_pairs, hit.intersecting_pairs);
   EXPECT_EQ(intersections(beside, sphere).pairs_tested, miss.pairs_tested);
+}
+
+TEST(SurfaceIntersections, ClosestVertexDistance) {
+  // A vertex nearest to a corner of the other triangle: |(2, 0, 1) - (1, 0, 0)| = sqrt(2).
+  Surface tri;
+  tri.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  tri.triangles = {{0, 1, 2}};
+  Surface off;
+  off.vertices = {{2, 0, 1}, {3, 0, 1}, {2, 1, 1}};
+  off.triangles = {{0, 1, 2}};
+  EXPECT_NEAR(closest_vertex_distance(off, tri), std::sqrt(2.0), 1e-15);
+  // Above the face's inside: the height.
+  off.vertices = {{0.2, 0.2, 0.3}, {3, 0, 1}, {2, 1, 1}};
+  EXPECT_NEAR(closest_vertex_distance(off, tri), 0.3, 1e-15);
+  // The sphere's vertices against a plane 1.01 from its centre: the point-to-plane distance of
+  // the vertex that comes nearest (the plane's grid reaches past the foot of every vertex).
+  const Vec centre = {0.1, -0.2, 0.3};
+  const Surface sphere = make_sphere(centre, 1.0, 32, 16);
+  const double s3 = 1 / std::sqrt(3.0);
+  const Surface beside = make_plane_grid({centre[0] + 1.01 * s3, centre[1] + 1.01 * s3, centre[2] + 1.01 * s3},
+                                         {s3, s3, s3}, 4.0, 30);
+  double expected = 1e9;
+  for (const auto& v : sphere.vertices)
+    expected = std::min(expected, 1.01 - ((v[0] - centre[0]) + (v[1] - centre[1]) + (v[2] - centre[2])) * s3);
+  EXPECT_NEAR(closest_vertex_distance(sphere, beside), expected, 1e-12);
+  EXPECT_GT(expected, 0.01);
+  // Touching: zero.
+  off.vertices = {{0.25, 0.25, 0}, {3, 0, 1}, {2, 1, 1}};
+  EXPECT_EQ(closest_vertex_distance(off, tri), 0.0);
 }
 
 TEST(SurfaceIntersections, ExamplesAreTheSmallestPairs) {

@@ -4,8 +4,9 @@
 // obstacle (see surface_intersections.hpp for what counts and the limitations). Prints one line
 // per check:
 //   self: N intersecting pairs (M tested)
-//   obstacle PATH: N intersecting pairs (M tested)
-// followed, on the same line when N > 0, by
+//   obstacle PATH: N intersecting pairs (M tested); closest vertex D m
+// (D: the smallest distance from a vertex of SURFACE to a triangle of the obstacle, a
+// floating-point measurement, closest_vertex_distance), followed, on the same line when N > 0, by
 //   ; K surface triangles involved; first pairs: i-j i-j ...
 // (up to 20 pairs, 0-based triangle indices in file order after fan triangulation; for an
 // obstacle line, i is the surface's triangle and j the obstacle's).
@@ -24,6 +25,7 @@
 #include <cstddef>
 #include <exception>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
@@ -174,7 +176,12 @@ int main(int argc, char** argv) {
     for (std::size_t k = 1; k < surfaces.size(); ++k) {
       const IntersectionReport r = clothsim::check::intersections(surfaces[0], surfaces[k]);
       any = any || r.intersecting_pairs > 0;
-      std::cout << "obstacle " << paths[k] << ": " << describe(r) << '\n';
+      std::ostringstream closest;
+      closest << std::setprecision(4) << clothsim::check::closest_vertex_distance(surfaces[0], surfaces[k]);
+      std::string line = describe(r);
+      const std::size_t cut = line.find(')') + 1;  // after "(M tested)"
+      line.insert(cut, "; closest vertex " + closest.str() + " m");
+      std::cout << "obstacle " << paths[k] << ": " << line << '\n';
     }
     std::cout.flush();
     return any ? 1 : 0;

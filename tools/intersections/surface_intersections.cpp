@@ -13,11 +13,15 @@
 #include <CGAL/Intersections_3/Segment_3_Segment_3.h>
 #include <CGAL/Intersections_3/Segment_3_Triangle_3.h>
 #include <CGAL/Intersections_3/Triangle_3_Triangle_3.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/box_intersection_d.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -229,6 +233,31 @@ IntersectionReport intersections(const Surface& a, const Surface& b) {
   };
   CGAL::box_intersection_d(pa.boxes.begin(), pa.boxes.end(), pb.boxes.begin(), pb.boxes.end(), callback);
   return collector.finish();
+}
+
+double closest_vertex_distance(const Surface& a, const Surface& b) {
+  prepare(a, "first surface", 0);  // the same input checks as the intersection tests
+  prepare(b, "second surface", a.triangles.size());
+  std::vector<Triangle> faces;
+  faces.reserve(b.triangles.size());
+  const auto point = [](const std::array<double, 3>& v) { return Point(v[0], v[1], v[2]); };
+  for (const auto& t : b.triangles) {
+    const Triangle f(point(b.vertices[static_cast<std::size_t>(t[0])]), point(b.vertices[static_cast<std::size_t>(t[1])]),
+                     point(b.vertices[static_cast<std::size_t>(t[2])]));
+    if (!f.is_degenerate()) faces.push_back(f);
+  }
+  if (faces.empty()) return std::numeric_limits<double>::infinity();
+  using Primitive = CGAL::AABB_triangle_primitive<Kernel, std::vector<Triangle>::const_iterator>;
+  using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+  Tree tree(faces.cbegin(), faces.cend());
+  tree.accelerate_distance_queries();
+  std::vector<char> used(a.vertices.size(), 0);
+  for (const auto& t : a.triangles)
+    for (const int v : t) used[static_cast<std::size_t>(v)] = 1;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t v = 0; v < a.vertices.size(); ++v)
+    if (used[v]) best = std::min(best, std::sqrt(CGAL::to_double(tree.squared_distance(point(a.vertices[v])))));
+  return best;
 }
 
 }  // namespace clothsim::check

@@ -67,4 +67,12 @@ IntersectionReport self_intersections(const Surface& s);
 // Intersections between the triangles of a and those of b (all pairs).
 IntersectionReport intersections(const Surface& a, const Surface& b);
 
+// How close a comes to b: the smallest distance from a vertex of a (one used by a triangle) to a
+// triangle of b (degenerate triangles of b are skipped), computed in floating point (CGAL's AABB
+// tree; not an exact predicate, a measurement). Vertex to face only: two edges crossing closer
+// than that are not seen. +infinity when b has no proper triangle. Together with "no
+// intersection", a positive value for a cloth that starts outside a closed obstacle says by how
+// much the cloth stayed out of it.
+double closest_vertex_distance(const Surface& a, const Surface& b);
+
 }  // namespace clothsim::check
