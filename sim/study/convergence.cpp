@@ -10,12 +10,14 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -241,6 +243,84 @@ struct Outcome {
   std::optional<double> tolerance;  // the linear solver's relative-residual tolerance (none: direct)
 };
 
+// Where the runner's runs come from (docs/cluster.md, the convergence study as tasks): computed
+// here (the usual way); only listed, with one of them computed (planning, and running one task);
+// or read back from the results of tasks that ran elsewhere (the gather).
+struct RunSource {
+  enum class Mode { compute, collect, stored };
+  Mode mode = Mode::compute;
+  std::string target;                                        // collect: the run to compute
+  std::optional<std::string> target_result;                  // collect: its result (run_json)
+  std::vector<std::string> ids;                              // collect: every run, in order of first need
+  const std::map<std::string, std::string>* stored = nullptr;  // stored: id → result text
+};
+
+// A run's id in a plan: letters, digits and . _ - only (the sweep's ids), from its parameters.
+std::string run_id(const std::string& text) {
+  std::string id;
+  for (const char ch : text) {
+    const bool plain = std::isalnum(static_cast<unsigned char>(ch)) || ch == '.' || ch == '_' || ch == '-';
+    id += plain ? ch : '_';
+  }
+  return id;
+}
+
+nlohmann::json optional_json(const std::optional<double>& x) { return x ? nlohmann::json(*x) : nlohmann::json(); }
+std::optional<double> optional_of(const nlohmann::json& j) {
+  return j.is_null() ? std::nullopt : std::optional<double>(j.get<double>());
+}
+
+// An outcome as the text a task leaves (exact doubles: nlohmann writes the shortest form that
+// reads back to the same double) and back. The fold surface is not kept (only its counts are).
+std::string run_json(const Outcome& o) {
+  nlohmann::json j;
+  j["failure"] = o.failure;
+  j["h"] = o.h;
+  j["energy"] = optional_json(o.energy);
+  j["folds_circumferential"] = optional_json(o.folds_circumferential);
+  j["folds_axial"] = optional_json(o.folds_axial);
+  j["tolerance"] = optional_json(o.tolerance);
+  j["vertices"] = o.run.vertices;
+  j["dofs"] = o.run.dofs;
+  j["steps"] = o.run.steps;
+  j["solver_iterations"] = o.run.solver_iterations;
+  j["wall_seconds"] = o.run.wall_seconds;
+  j["final_elastic_energy"] = std::isfinite(o.run.final_elastic_energy) ? nlohmann::json(o.run.final_elastic_energy)
+                                                                         : nlohmann::json();
+  nlohmann::json samples = nlohmann::json::array();
+  for (const Eigen::MatrixX3d& u : o.run.displacements) {
+    nlohmann::json rows = nlohmann::json::array();
+    for (Eigen::Index i = 0; i < u.rows(); ++i) rows.push_back({u(i, 0), u(i, 1), u(i, 2)});
+    samples.push_back(rows);
+  }
+  j["displacements"] = samples;
+  return j.dump() + "\n";
+}
+
+Outcome outcome_of(const std::string& text) {
+  const nlohmann::json j = nlohmann::json::parse(text);
+  Outcome o;
+  o.failure = j.at("failure").get<std::string>();
+  o.h = j.at("h").get<double>();
+  o.energy = optional_of(j.at("energy"));
+  o.folds_circumferential = optional_of(j.at("folds_circumferential"));
+  o.folds_axial = optional_of(j.at("folds_axial"));
+  o.tolerance = optional_of(j.at("tolerance"));
+  o.run.vertices = j.at("vertices").get<int>();
+  o.run.dofs = j.at("dofs").get<int>();
+  o.run.steps = j.at("steps").get<int>();
+  o.run.solver_iterations = j.at("solver_iterations").get<long long>();
+  o.run.wall_seconds = j.at("wall_seconds").get<double>();
+  if (!j.at("final_elastic_energy").is_null()) o.run.final_elastic_energy = j.at("final_elastic_energy").get<double>();
+  for (const nlohmann::json& rows : j.at("displacements")) {
+    Eigen::MatrixX3d u(static_cast<Eigen::Index>(rows.size()), 3);
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      for (int k = 0; k < 3; ++k) u(static_cast<Eigen::Index>(i), k) = rows.at(i).at(static_cast<std::size_t>(k)).get<double>();
+    o.run.displacements.push_back(u);
+  }
+  return o;
+}
+
 const Method& find_method(const std::vector<Method>& methods, const std::vector<Method>& registered,
                           const std::string& name) {
   for (const std::vector<Method>* list : {&methods, &registered})
@@ -270,7 +350,8 @@ MethodRun solve_static_timed(const Method& method, const Problem& problem,
 
 class StudyRunner {
  public:
-  StudyRunner(const std::vector<Method>& methods, const LogFn& log) : methods_(methods), log_(log) {}
+  StudyRunner(const std::vector<Method>& methods, const LogFn& log, RunSource& source)
+      : methods_(methods), log_(log), source_(source) {}
 
   void run_plate(const PlateStudyCase& c, std::vector<ConvergenceRow>& rows) {
     for (const Method& method : methods_) {
@@ -287,7 +368,16 @@ class StudyRunner {
         const Eigen::MatrixX2d chart = problem.mesh.vertices.leftCols<2>();  // (x, y) [m]
         const std::vector<SurfaceSample> centre =
             locate_points(problem.mesh.triangles, chart, Eigen::MatrixX2d::Zero(1, 2));
-        warm_up(method, problem, centre);
+        const Outcome o = get(run_id(std::string(c.plate.id) + "." + method.name + "." + std::to_string(n) + "x" + std::to_string(n)), [&] {
+          Outcome computed;
+          warm_up(method, problem, centre);
+          try {
+            computed.run = solve_static_timed(method, problem, centre);
+          } catch (const std::exception& e) {
+            computed.failure = e.what();
+          }
+          return computed;
+        });
         ConvergenceRow row;
         row.case_name = c.plate.id;
         row.method = method.name;
@@ -302,13 +392,12 @@ class StudyRunner {
         ref << "analytic (Timoshenko & Woinowsky-Krieger): w = " << c.plate.coefficient
             << (c.plate.point_load ? " P a^2 / D" : " q a^4 / D");
         row.reference = ref.str();
-        try {
-          const MethodRun run = solve_static_timed(method, problem, centre);
-          fill_run(row, run);
-          row.value = -run.displacements.at(0)(0, 2);
+        if (o.failure.empty()) {
+          fill_run(row, o.run);
+          row.value = -o.run.displacements.at(0)(0, 2);
           row.error = std::abs(row.value - row.reference_value) / std::abs(row.reference_value);
-        } catch (const std::exception& e) {
-          mark_failed(row, e.what());
+        } else {
+          mark_failed(row, o.failure);
         }
         report(row);
         rows.push_back(row);
@@ -520,6 +609,49 @@ class StudyRunner {
     const std::string key = method.name + " " + sleeve_setting(m, dt) + " tol=" +
                             (effective ? format_shortest(*effective) : std::string("direct")) + " t=" + join_times(times);
     if (auto it = cache_.find(key); it != cache_.end()) return it->second;
+    const std::string id =
+        run_id(c.name + "." + method.name + "." + std::to_string(m.segments) + "x" + std::to_string(m.rings) + ".dt" +
+               format_shortest(dt) + ".tol" + (effective ? format_shortest(*effective) : std::string("direct")) +
+               (times == all_sample_times(c) ? std::string() : ".t" + join_times(times)));
+    return cache_.emplace(key, get(id, [&] { return compute(c, problem, times, method, effective); })).first->second;
+  }
+
+  // The outcome of run `id`: computed by `compute`, or as the source says.
+  template <class Compute>
+  Outcome get(const std::string& id, const Compute& compute) {
+    switch (source_.mode) {
+      case RunSource::Mode::compute:
+        return compute();
+      case RunSource::Mode::collect: {
+        if (std::find(source_.ids.begin(), source_.ids.end(), id) == source_.ids.end()) source_.ids.push_back(id);
+        Outcome o;
+        if (id == source_.target && !source_.target_result) {
+          o = compute();
+          source_.target_result = run_json(o);
+        } else {
+          o.failure = "planned";
+        }
+        return o;
+      }
+      case RunSource::Mode::stored: {
+        const auto it = source_.stored->find(id);
+        if (it == source_.stored->end()) {
+          Outcome missing;
+          missing.failure = "run " + id + " did not finish";
+          return missing;
+        }
+        try {
+          return outcome_of(it->second);
+        } catch (const std::exception& e) {
+          throw std::runtime_error("the result of run " + id + ": " + e.what());
+        }
+      }
+    }
+    return compute();
+  }
+
+  Outcome compute(const SleeveStudyCase& c, const Problem& problem, const std::vector<double>& times,
+                  const Method& method, std::optional<double> effective) {
     Outcome o;
     o.tolerance = effective;
     o.h = mesh_size(problem.mesh);
@@ -540,12 +672,13 @@ class StudyRunner {
     } catch (const std::exception& e) {
       o.failure = e.what();
     }
-    return cache_.emplace(key, std::move(o)).first->second;
+    return o;
   }
 
   const std::vector<Method>& methods_;
   const std::vector<Method> registered_ = convergence_methods();
   const LogFn& log_;
+  RunSource& source_;
   std::map<std::string, Outcome> cache_;
   std::set<std::string> warmed_up_;  // methods that have had their untimed static solve
 };
@@ -693,14 +826,54 @@ ConvergencePlan quick_convergence_plan(const std::filesystem::path& scenes_dir) 
   return plan;
 }
 
-std::vector<ConvergenceRow> run_convergence(const ConvergencePlan& plan, const std::vector<Method>& methods,
-                                            const LogFn& log) {
+namespace {
+
+std::vector<ConvergenceRow> run_with(const ConvergencePlan& plan, const std::vector<Method>& methods, const LogFn& log,
+                                     RunSource& source) {
   std::vector<ConvergenceRow> rows;
-  StudyRunner runner(methods, log);
+  StudyRunner runner(methods, log, source);
   for (const PlateStudyCase& c : plan.plates) runner.run_plate(c, rows);
   for (const SleeveStudyCase& c : plan.sleeves) runner.run_sleeve(c, rows);
   fill_orders(rows);
   return rows;
+}
+
+}  // namespace
+
+std::vector<ConvergenceRow> run_convergence(const ConvergencePlan& plan, const std::vector<Method>& methods,
+                                            const LogFn& log) {
+  RunSource source;
+  return run_with(plan, methods, log, source);
+}
+
+std::vector<std::string> convergence_run_ids(const ConvergencePlan& plan, const std::vector<Method>& methods) {
+  RunSource source;
+  source.mode = RunSource::Mode::collect;
+  run_with(plan, methods, LogFn(), source);
+  return source.ids;
+}
+
+std::string run_convergence_run(const ConvergencePlan& plan, const std::vector<Method>& methods, const std::string& id,
+                                const LogFn& log) {
+  RunSource source;
+  source.mode = RunSource::Mode::collect;
+  source.target = id;
+  run_with(plan, methods, LogFn(), source);
+  if (!source.target_result) throw std::invalid_argument("the convergence study's plan has no run \"" + id + "\"");
+  if (log) {
+    const Outcome o = outcome_of(*source.target_result);
+    log(id + ": " + (o.failure.empty() ? "done" : "failed: " + o.failure) + " (" + format_fixed(o.run.wall_seconds, 2) +
+        " s)");
+  }
+  return *source.target_result;
+}
+
+std::vector<ConvergenceRow> gather_convergence(const ConvergencePlan& plan, const std::vector<Method>& methods,
+                                               const std::map<std::string, std::string>& results, const LogFn& log) {
+  RunSource source;
+  source.mode = RunSource::Mode::stored;
+  source.stored = &results;
+  return run_with(plan, methods, log, source);
 }
 
 const std::vector<std::string>& results_csv_columns() {

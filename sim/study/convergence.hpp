@@ -48,6 +48,7 @@
 #include <limits>
 #include <optional>
 #include <ostream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -243,6 +244,26 @@ struct ConvergenceRow {
 // rows get error NaN and a note.
 std::vector<ConvergenceRow> run_convergence(const ConvergencePlan& plan, const std::vector<Method>& methods,
                                             const LogFn& log);
+
+// The study as independent runs (docs/cluster.md): every simulation of a sleeve (a method on a
+// mesh at a time step and solver tolerance, sampled at the times its windows need; the reference
+// run included) and every static solve of a plate (a method on a grid) has a stable id made of
+// those parameters, e.g. "sleeve_gravity.loop_three_point.26x19.dt0.001.tol1e-08". Each can run
+// anywhere; the rows are then built from the stored results as run_convergence builds them (the
+// same numbers but wall times, which are each run's own).
+//
+// The runs of `plan` in the order the study first needs them.
+std::vector<std::string> convergence_run_ids(const ConvergencePlan& plan, const std::vector<Method>& methods);
+// Runs run `id` and returns its result as text (JSON: the sampled displacements, end energy, fold
+// counts, counts and time; exact doubles). A run that fails returns its failure in the result.
+// Throws std::invalid_argument for an id that is not in the plan.
+std::string run_convergence_run(const ConvergencePlan& plan, const std::vector<Method>& methods, const std::string& id,
+                                const LogFn& log);
+// The rows from stored results (id → the text run_convergence_run returned); a run without a
+// result marks its rows failed ("run ID did not finish"). Throws std::runtime_error naming a run
+// whose result cannot be read.
+std::vector<ConvergenceRow> gather_convergence(const ConvergencePlan& plan, const std::vector<Method>& methods,
+                                               const std::map<std::string, std::string>& results, const LogFn& log);
 
 // The CSV columns, in order: case, method, series, window, setting, vertices, dofs, h, dt, steps,
 // wall_seconds, solver_iterations, error, order, quantity, value, reference_value,

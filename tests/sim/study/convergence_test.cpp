@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -474,6 +476,52 @@ TEST(ConvergenceStudy, FailedRunsAreRecordedNotFatal) {
   ASSERT_EQ(rows.size(), 1u);
   EXPECT_TRUE(std::isnan(rows[0].error));
   EXPECT_NE(rows[0].note.find("singular, on purpose"), std::string::npos) << rows[0].note;
+}
+
+// The study as independent runs: the quick plan's runs listed (unique ids, the reference first
+// among the sleeve's), each run alone (in reverse order) and the rows gathered from their results
+// are the rows of the one-process study in every column but wall_seconds; a missing result marks exactly the rows that need it; an unknown id is
+// refused.
+TEST(ConvergenceStudy, RunsAsTasksGiveTheSameRows) {
+  ConvergencePlan plan = quick_convergence_plan(CLOTHSIM_SOURCE_DIR "/scenes");
+  const std::vector<Method> methods = convergence_methods();
+  const std::vector<std::string> ids = convergence_run_ids(plan, methods);
+  ASSERT_GT(ids.size(), 5u);
+  EXPECT_EQ(std::set<std::string>(ids.begin(), ids.end()).size(), ids.size());
+  for (const std::string& id : ids)
+    EXPECT_EQ(id.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-"), std::string::npos)
+        << id;
+  const auto sleeve = std::find_if(ids.begin(), ids.end(), [](const std::string& id) { return id.rfind("sleeve_", 0) == 0; });
+  ASSERT_NE(sleeve, ids.end());
+  EXPECT_EQ(sleeve->rfind("sleeve_twist.loop_three_point.", 0), 0u) << *sleeve;  // the reference run
+
+  std::map<std::string, std::string> results;
+  for (auto it = ids.rbegin(); it != ids.rend(); ++it) results[*it] = run_convergence_run(plan, methods, *it, {});
+  const std::vector<ConvergenceRow> gathered = gather_convergence(plan, methods, results, {});
+  const std::vector<ConvergenceRow> direct = run_convergence(plan, methods, {});
+  ASSERT_EQ(gathered.size(), direct.size());
+  const auto without_time = [](std::vector<ConvergenceRow> rows) {
+    for (ConvergenceRow& r : rows) r.wall_seconds = 0;
+    std::ostringstream out;
+    write_results_csv(out, rows);
+    return out.str();
+  };
+  EXPECT_EQ(without_time(gathered), without_time(direct));
+
+  // Without the reference run's result: every row of the sleeve is marked, no plate row.
+  std::map<std::string, std::string> partial = results;
+  partial.erase(*sleeve);
+  for (const ConvergenceRow& r : gather_convergence(plan, methods, partial, {})) {
+    if (r.case_name.rfind("sleeve_", 0) == 0) {
+      EXPECT_TRUE(std::isnan(r.error)) << r.setting;
+      EXPECT_NE(r.note.find("run " + *sleeve + " did not finish"), std::string::npos) << r.note;
+    } else {
+      EXPECT_TRUE(std::isfinite(r.error)) << r.case_name;
+    }
+  }
+  EXPECT_THROW(run_convergence_run(plan, methods, "no_such_run", {}), std::invalid_argument);
+  partial[ids.front()] = "{not json";
+  EXPECT_THROW(gather_convergence(plan, methods, partial, {}), std::runtime_error);
 }
 
 // Line n (from 0) of `text`, without its line break.
