@@ -249,21 +249,13 @@ int study_command(int argc, char** argv) {
       app.add_option("--amplitude", amplitude, "folds: imperfection amplitude [m] (default 0.5 t_eff)")->type_name("M"),
       app.add_option("--dt", dt, "folds: time step [s] (default 0.005)")->type_name("S"),
       app.add_option("--end", end, "folds: simulated time [s] (default 1, the end of the motion)")->type_name("S")};
-  // Plan / task / gather and the executors: `study folds` and `study stability`.
+  // Plan / task / gather and the executors: every study.
   clothsim::SweepCommand sweep;
   std::string plan_dir, gather_dir;
-  const std::vector<CLI::Option*> sweep_options = add_sweep_options(app, sweep, plan_dir, gather_dir);
+  add_sweep_options(app, sweep, plan_dir, gather_dir);
   if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
   options.out_root = out;
   options.plot = !no_plot;
-  if (which == "convergence")
-    for (const CLI::Option* o : sweep_options)
-      if (o->count() > 0) {
-        std::cerr << "clothsim: error: " << o->get_name()
-                  << " applies to `clothsim study folds` and `study stability` only (the convergence study runs in "
-                     "one process)\n";
-        return 1;
-      }
   finish_sweep_options(app, argv, sweep, plan_dir, gather_dir);
   if (which != "folds")
     for (const CLI::Option* o : fold_options)
@@ -277,7 +269,7 @@ int study_command(int argc, char** argv) {
     if (fold_options[7]->count() > 0) folds.end = end;
     return clothsim::run_fold_study_report(options, folds, sweep);
   }
-  return which == "convergence" ? clothsim::run_convergence_study(options)
+  return which == "convergence" ? clothsim::run_convergence_study(options, sweep)
                                 : clothsim::run_stability_study(options, sweep);
 }
 

@@ -3,7 +3,7 @@
 // scripts/plot_<name>.py with Debian's python3-matplotlib) and prints where it wrote.
 // The folder is published atomically: it is built under a temporary name and renamed at the end,
 // so a failed or interrupted study leaves an older report untouched.
-// The fold study and the stability matrix can also run as a sweep of tasks (app/sweep.hpp,
+// The fold study, the stability matrix and the convergence study can also run as a sweep of tasks (app/sweep.hpp,
 // docs/cluster.md): planned into a folder, each case run by `clothsim task`, locally in parallel or
 // as a Slurm job array, and gathered into the same report.
 #pragma once
@@ -24,7 +24,10 @@ struct StudyOptions {
 };
 
 // Return the process exit code: 0 on success, 1 on error (message on stderr, "clothsim: error: ...").
-int run_convergence_study(const StudyOptions& options);
+int run_convergence_study(const StudyOptions& options, SweepCommand sweep = {});
+// The convergence study's tasks (one per run, id from convergence_run_ids; result.json) and report.
+const SweepHooks& convergence_sweep_hooks();
+SweepStudy convergence_study_sweep(bool quick);
 int run_stability_study(const StudyOptions& options, SweepCommand sweep = {});
 // The stability matrix's tasks (one per case, id: its name; result.json) and report.
 const SweepHooks& stability_sweep_hooks();

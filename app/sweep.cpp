@@ -225,6 +225,7 @@ void log_line(const std::string& line) { std::cerr << "clothsim: " << line << st
 const SweepHooks& sweep_hooks(const std::string& name) {
   if (name == "folds") return fold_sweep_hooks();
   if (name == "stability") return stability_sweep_hooks();
+  if (name == "convergence") return convergence_sweep_hooks();
   if (name == "figures") return figures_sweep_hooks();
   throw std::invalid_argument("\"" + name + "\" cannot be run as tasks (folds, stability and figures can)");
 }
