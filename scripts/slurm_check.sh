@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CI check of issue 31: the quick fold study and the quick stability matrix, each run serially,
+# CI check of issue 31: the quick fold study, stability matrix and convergence study, each run serially,
 # with the local executor (-j 2) and as a Slurm job array on a one-node cluster started here
 # (scripts/slurm_local.sh, as root), give the same results.csv in every column but wall_seconds;
 # `clothsim figures 10 --quick` the same fig10.png and fig10.md (wall times aside).
@@ -31,7 +31,7 @@ fi
 cluster=$(since "$t")
 
 summary=""
-for name in folds stability; do
+for name in folds stability convergence; do
   study=(study "$name" --quick --no-plot)
   t=$(now)
   "$bin" "${study[@]}" --out "$tmp/serial" 2>"$tmp/serial_$name.log" >/dev/null
@@ -78,7 +78,7 @@ def rows(run, study):
         table = list(csv.reader(f))
     drop = table[0].index("wall_seconds")
     return [r[:drop] + r[drop + 1:] for r in table]
-for study in ("folds", "stability"):
+for study in ("folds", "stability", "convergence"):
     serial = rows("serial", study)
     for other in ("local", "slurm"):
         got = rows(other, study)

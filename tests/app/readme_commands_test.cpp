@@ -141,9 +141,9 @@ const std::map<std::string, Form>& forms() {
       {"clothsim study folds",
        {{"{clothsim} study folds --quick --no-plot --cases twist --out {tmp}/studies"}, "{clothsim} study --help", ""}},
       // The fold study as tasks: plan, one task, the rest in this process (--executor local -j 1),
-      // gather; the Slurm scripts of both studies as dry runs (no Slurm needed). -j N > 1, the
+      // gather; the Slurm scripts of the three studies as dry runs (no Slurm needed). -j N > 1, the
       // stability tasks and the Slurm executor: StudySweepCli.*, scripts/slurm_check.sh.
-      {"clothsim study folds\\|stability --plan DIR",
+      {"clothsim study folds\\|stability\\|convergence --plan DIR",
        {{"{clothsim} study folds --quick --no-plot --cases twist --methods mass_spring --plan {tmp}/sweep "
          "--out {tmp}/sweep_out",
          "{clothsim} task {tmp}/sweep twist-mass_spring-13x9-seed1",
@@ -152,7 +152,8 @@ const std::map<std::string, Form>& forms() {
          "test -s {tmp}/sweep_out/study_folds/results.csv",
          "{clothsim} study folds --quick --no-plot --cases twist --plan {tmp}/sweep_dry --executor slurm --dry-run "
          "--slurm-time 10 --slurm-mem 1G --partition p --account a --sbatch-arg=--qos=low --no-wait",
-         "{clothsim} study stability --quick --no-plot --plan {tmp}/stability_dry --executor slurm --dry-run"},
+         "{clothsim} study stability --quick --no-plot --plan {tmp}/stability_dry --executor slurm --dry-run",
+         "{clothsim} study convergence --quick --no-plot --plan {tmp}/convergence_dry --executor slurm --dry-run"},
         "{clothsim} study --help",
         ""}},
       {"clothsim task DIR ID",
