@@ -10,6 +10,7 @@
 #include "app/frame_images.hpp"
 #include "app/limit_surface_drawer.hpp"
 #include "app/output_folders.hpp"
+#include "app/point_cache.hpp"
 #include "render/renderer.hpp"
 
 #include "sim/contact/obstacle.hpp"
@@ -738,6 +739,17 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
     } catch (const std::exception& e) {
       if (failure.empty()) failure = std::string("rendering failed: ") + e.what();
       else log_line("warning: rendering failed: " + std::string(e.what()));
+    }
+  }
+  // The point cache of the frames on disk (also after a failure or an interruption: what was written).
+  if (scene.point_cache == "pc2") {
+    try {
+      const PointCacheReport cache = write_point_cache(dir);
+      log_line("wrote " + (dir / "cache.pc2").string() + " (" + std::to_string(cache.frames) + " frames of " +
+               std::to_string(cache.points) + " points) and cache_rest.obj");
+    } catch (const std::exception& e) {
+      if (failure.empty()) failure = std::string("point cache: ") + e.what();
+      else log_line("warning: point cache: " + std::string(e.what()));
     }
   }
   const std::string status = !failure.empty() ? "failed" : interrupted != 0 ? "interrupted" : "completed";

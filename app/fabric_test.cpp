@@ -31,20 +31,6 @@ std::string percent(double value, double reference) { return fixed(100.0 * (valu
 
 void say(const std::string& line) { std::cerr << "clothsim: fabric-test: " << line << '\n'; }
 
-// The files of a run folder whose names start with `prefix` and end with `suffix`, sorted.
-std::vector<fs::path> files_like(const fs::path& dir, const std::string& prefix, const std::string& suffix) {
-  std::vector<fs::path> found;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
-    const std::string name = e.path().filename().string();
-    if (name.size() >= prefix.size() + suffix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
-        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
-      found.push_back(e.path());
-  }
-  std::sort(found.begin(), found.end());
-  return found;
-}
-
 // Writes `scene` as runs/<name>.json and runs it with the command's own runner into runs/<name>/.
 fs::path run_scene(const Json& scene, const fs::path& runs, const FabricTestOptions& o) {
   const std::string name = scene.at("name").get<std::string>();

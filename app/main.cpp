@@ -4,6 +4,7 @@
 #include "app/fabric_test.hpp"
 #include "app/figures.hpp"
 #include "app/golden.hpp"
+#include "app/point_cache.hpp"
 #include "app/render_saved.hpp"
 #include "app/run.hpp"
 #include "app/study.hpp"
@@ -79,6 +80,28 @@ int render_command(int argc, char** argv) {
                       : surface == "flat"     ? clothsim::DrawnSurface::flat
                                               : clothsim::DrawnSurface::method;
   return clothsim::render_saved_run(dir, options);
+}
+
+// `clothsim cache DIR`.
+int cache_command(int argc, char** argv) {
+  CLI::App app{"clothsim cache: a finished dynamic run's motion as a point cache for animation tools: from\n"
+               "DIR/frames/mesh_NNNN.obj (\"output\": {\"obj\": true}) writes DIR/cache.pc2 (PC2, one sample\n"
+               "per frame, read by Blender's Mesh Cache modifier and Houdini) and DIR/cache_rest.obj (the\n"
+               "first frame with normals and texture coordinates, the object to apply it to). The scene key\n"
+               "\"output\": {\"cache\": \"pc2\"} does the same at the end of the run (docs/animation_tools.md).",
+               "clothsim cache"};
+  std::string dir;
+  app.add_option("dir", dir, "Output folder of a dynamic run (with frames/mesh_*.obj)")->required()->type_name("DIR");
+  if (const int code = parse(app, argc - 1, argv + 1); code >= 0) return code;
+  try {
+    const clothsim::PointCacheReport r = clothsim::write_point_cache(dir);
+    std::cout << "wrote " << (std::filesystem::path(dir) / "cache.pc2").string() << " (" << r.frames << " frames of "
+              << r.points << " points) and cache_rest.obj\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "clothsim: error: cache: " << e.what() << '\n';
+    return 1;
+  }
 }
 
 // The tolerance options of `compare` and `golden check`.
@@ -222,7 +245,7 @@ void finish_sweep_options(CLI::App& app, char** argv, clothsim::SweepCommand& sw
 int study_command(int argc, char** argv) {
   CLI::App app{"clothsim study: the reports of error against run time (convergence), of numerical\n"
                "stability on stiff and extreme cases (stability) and of fold counts against resolution\n"
-               "(folds); see README.md, \"Studies\".",
+               "(folds); see docs/studies.md.",
                "clothsim study"};
   std::string which;
   clothsim::StudyOptions options;
@@ -413,6 +436,7 @@ int main(int argc, char** argv) {
   if (argc >= 2 && std::string(argv[1]) == "figures") return figures_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "task") return task_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "compare") return compare_command(argc, argv);
+  if (argc >= 2 && std::string(argv[1]) == "cache") return cache_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "golden") return golden_command(argc, argv);
   if (argc >= 2 && std::string(argv[1]) == "fabric-test") return fabric_test_command(argc, argv);
   CLI::App app{
@@ -425,8 +449,9 @@ int main(int argc, char** argv) {
       "Other commands (each has its own --help):\n"
       "  clothsim render DIR                         draw a run's saved geometry again\n"
       "  clothsim compare A B                        compare two PNGs, or two folders' PNGs\n"
+      "  clothsim cache DIR                          a run's frames as a PC2 point cache (Blender, Houdini)\n"
       "  clothsim golden check|update MANIFEST       check or rewrite golden images of scenes\n"
-      "  clothsim study convergence|stability|folds  write a report of README.md, \"Studies\"\n"
+      "  clothsim study convergence|stability|folds  write a report (docs/studies.md)\n"
       "  clothsim figures [N ...]                    the paper's Figs. 1, 7-11 (docs/figures.md)\n"
       "  clothsim task DIR ID                        one task of a planned study (docs/cluster.md)\n"
       "  clothsim fabric-test PRESET|SCENE.json      standard fabric tests, virtually (docs/fabric_test.md)\n",

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 
@@ -36,6 +37,20 @@ void check_folder_possible(const std::filesystem::path& dir) {
   while (!p.empty() && !std::filesystem::exists(p, ec) && p != p.parent_path()) p = p.parent_path();
   if (!p.empty() && std::filesystem::exists(p, ec) && !std::filesystem::is_directory(p, ec))
     throw std::runtime_error(dir.string() + ": cannot be a folder, " + p.string() + " is not a folder");
+}
+
+std::vector<std::filesystem::path> files_like(const std::filesystem::path& dir, const std::string& prefix,
+                                              const std::string& suffix) {
+  std::vector<std::filesystem::path> found;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() >= prefix.size() + suffix.size() && name.compare(0, prefix.size(), prefix) == 0 &&
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+      found.push_back(e.path());
+  }
+  std::sort(found.begin(), found.end());
+  return found;
 }
 
 void write_text_file(const std::filesystem::path& path, const std::string& text) {

@@ -16,6 +16,11 @@ std::vector<std::filesystem::path> missing_folders(const std::filesystem::path& 
 // it runs anything.
 void check_folder_possible(const std::filesystem::path& dir);
 
+// The files in `dir` whose names start with `prefix` and end with `suffix`, sorted by name (none if
+// `dir` cannot be read).
+std::vector<std::filesystem::path> files_like(const std::filesystem::path& dir, const std::string& prefix,
+                                              const std::string& suffix);
+
 // Writes `text` to `path` (binary, replacing the file); throws std::runtime_error naming the path
 // when the file cannot be written.
 void write_text_file(const std::filesystem::path& path, const std::string& text);

@@ -6,7 +6,7 @@
 # GoogleTest cases (tests/CMakeLists.txt); a name that no longer exists is ignored. CMake 3.25 names
 # a parameterised case with its GetParam() comment, later versions without: both are listed.
 # Not listed although over 8 s: ReadmeCommands.EveryRowHasACheapFormThatRuns (37 s), which runs
-# every command of README.md once and found the checkpoint reader's memcpy into an empty vector;
+# every command of docs/cli.md once and found the checkpoint reader's memcpy into an empty vector;
 # Install.InstalledClothsimRunsWithoutTheSourceTree (18 s; added after this file is included, so
 # it could not be labelled here).
 set(clothsim_slow_tests

@@ -255,13 +255,18 @@ InitialState read_initial(const Reader& r, const Json* j) {
 
 void read_output(const Reader& r, const Json* j, Scene& scene) {
   if (j == nullptr) return;
-  r.check_object(*j, "output", {"obj", "obj_level", "checkpoint_every"});
+  r.check_object(*j, "output", {"obj", "obj_level", "checkpoint_every", "cache"});
   if (const Json* every = r.find(*j, "checkpoint_every"))
     scene.checkpoint_every = r.integer_at_least(*every, "output.checkpoint_every", 0);
   if (const Json* obj = r.find(*j, "obj")) scene.write_obj_frames = r.boolean(*obj, "output.obj");
   if (const Json* level = r.find(*j, "obj_level")) {
     scene.obj_level = r.integer_at_least(*level, "output.obj_level", 0);
     if (scene.obj_level > 4) r.fail("output.obj_level", "must be an integer from 0 to 4 (got " + level->dump() + ")");
+  }
+  if (const Json* cache = r.find(*j, "cache")) {
+    scene.point_cache = r.choice(*cache, "output.cache", {"none", "pc2"}, "point cache");
+    if (scene.point_cache != "none" && !scene.write_obj_frames)
+      r.fail("output.cache", "\"" + scene.point_cache + "\" is built from the OBJ frames: needs \"obj\": true");
   }
 }
 

@@ -76,6 +76,9 @@ struct Scene {
   bool write_obj_frames = false;  // dynamic scenes: "output": {"obj": true}
   int obj_level = 0;              // "output.obj_level": OBJ frames hold the limit surface refined this
                                   // many times (0: the limit points at the control connectivity)
+  // "output.cache": "pc2" builds a point cache from the OBJ frames at the end of the run
+  // (cache.pc2, cache_rest.obj; app/point_cache.hpp); "none" (default) does not.
+  std::string point_cache = "none";
   int checkpoint_every = 0;       // "output.checkpoint_every": a checkpoint for --resume every this
                                   // many frames (0: only when interrupted)
   RenderSettings render;

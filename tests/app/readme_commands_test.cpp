@@ -1,11 +1,12 @@
-// Every command of README.md's Commands table, run in a cheap form. The table is read from the
-// README at test time and each row is matched, by its command (the first backticked text of its
-// first cell, up to the first " ["), to a form below: a row with no form here fails the test, so
-// the table cannot gain or change a command unnoticed. A form runs shell commands that must exit
-// with code 0, and for the commands that have a --help, every --option the row documents must
-// appear in that help. Commands that install packages, rebuild the project or rewrite the
-// repository's goldens are only checked for syntax; benchmarks and tools that the test build does
-// not make, and scripts whose Python modules are missing, are skipped with a notice.
+// Every command of the Commands table in docs/cli.md (the README links to it), run in a cheap
+// form. The table is read from docs/cli.md at test time and each row is matched, by its command
+// (the first backticked text of its first cell, up to the first " ["), to a form below: a row
+// with no form here fails the test, so the table cannot gain or change a command unnoticed. A
+// form runs shell commands that must exit with code 0, and for the commands that have a --help,
+// every --option the row documents must appear in that help. Commands that install packages,
+// rebuild the project or rewrite the repository's goldens are only checked for syntax; benchmarks
+// and tools that the test build does not make, and scripts whose Python modules are missing, are
+// skipped with a notice.
 #include "tests/support/process.hpp"
 
 #include <gtest/gtest.h>
@@ -35,7 +36,7 @@ struct Row {
 
 // The rows of the table under "## Commands" (up to the next heading).
 std::vector<Row> readme_command_rows() {
-  std::ifstream in(fs::path(CLOTHSIM_SOURCE_DIR) / "README.md");
+  std::ifstream in(fs::path(CLOTHSIM_SOURCE_DIR) / "docs" / "cli.md");
   std::vector<Row> rows;
   std::string line;
   bool in_section = false;
@@ -84,7 +85,7 @@ const std::map<std::string, Form>& forms() {
       {"clothsim --help", {{"{clothsim} --help", "{clothsim} --version"}, "", ""}},
       {"clothsim SCENE.json --frames N",
        {{"{clothsim} {src}/scenes/sleeve_twist.json --out {tmp}/out_frames --frames 1 --size 32x32",
-         // --video needs ffmpeg (optional, README "Quick start").
+         // --video needs ffmpeg (optional, README "Quick start"; docs/cli.md).
          "if command -v ffmpeg >/dev/null 2>&1; then {clothsim} {src}/scenes/sleeve_twist.json --out {tmp}/out_video "
          "--frames 1 --size 32x32 --video; fi"},
         "{clothsim} --help",
@@ -131,6 +132,12 @@ const std::map<std::string, Form>& forms() {
        {{"{clothsim} {src}/scenes/plate_ss.json --out {tmp}/cmp --size 64x48",
          "{clothsim} compare {tmp}/cmp/plate_ss/limit.png {tmp}/cmp/plate_ss/limit.png"},
         "{clothsim} compare --help",
+        ""}},
+      {"clothsim cache DIR",
+       {{"{clothsim} {src}/scenes/sleeve_twist.json --out {tmp}/cache --no-render --frames 3 --set output.obj=true",
+         "{clothsim} cache {tmp}/cache/sleeve_twist", "test -s {tmp}/cache/sleeve_twist/cache.pc2",
+         "test -s {tmp}/cache/sleeve_twist/cache_rest.obj"},
+        "{clothsim} cache --help",
         ""}},
       {"clothsim golden check\\|update MANIFEST",
        {{"{clothsim} golden update {tmp}/goldens.txt", "{clothsim} golden check {tmp}/goldens.txt"},
@@ -275,12 +282,12 @@ class ReadmeCommands : public ::testing::Test {
 
 TEST_F(ReadmeCommands, EveryRowHasACheapFormThatRuns) {
   const std::vector<Row> rows = readme_command_rows();
-  ASSERT_GE(rows.size(), 15u) << "the Commands table of README.md was not found";
+  ASSERT_GE(rows.size(), 15u) << "the Commands table of docs/cli.md was not found";
   for (const Row& row : rows) {
-    SCOPED_TRACE("README row: " + row.command);
+    SCOPED_TRACE("docs/cli.md row: " + row.command);
     const auto form = forms().find(row.key);
     if (form == forms().end()) {
-      ADD_FAILURE() << "no cheap form for the README command '" << row.key
+      ADD_FAILURE() << "no cheap form for the docs/cli.md command '" << row.key
                     << "': add one to tests/app/readme_commands_test.cpp";
       continue;
     }
@@ -298,7 +305,7 @@ TEST_F(ReadmeCommands, EveryRowHasACheapFormThatRuns) {
     const std::string help = output();
     for (const std::string& option : documented_options(row.command))
       EXPECT_NE(help.find(option), std::string::npos)
-          << "README documents " << option << " but `" << expand(form->second.help) << "` does not list it";
+          << "docs/cli.md documents " << option << " but `" << expand(form->second.help) << "` does not list it";
   }
 }
 
