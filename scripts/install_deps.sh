@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libsuitesparse-dev libopenblas0-pthread libpng-dev libosmesa6-dev libembree-dev libtbb-dev
   libgtest-dev libbenchmark-dev libcli11-dev nlohmann-json3-dev libcgal-dev
   python3-minimal python3-matplotlib python3-jsonschema
+  pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module (python/, docs/python.md) and its tests
   parallel  # clothsim study ... -j N (the local executor, docs/cluster.md)
   clang libclang-rt-14-dev llvm  # scripts/sanitize.sh: clang 14, its sanitizer and libFuzzer run-times, llvm-symbolizer
 )

@@ -3,6 +3,8 @@
 // x86-64: CLOTHSIM_X86_KERNELS, set in sim/CMakeLists.txt).
 #include "sim/corotation/assembly_kernels.hpp"
 
+#include "sim/core/kernel_choice.hpp"
+
 #include <Eigen/Core>
 
 #include <cstdlib>
@@ -17,7 +19,7 @@ using Lanes = Eigen::Array<double, kLanes, 1>;
 #if defined(CLOTHSIM_X86_KERNELS)
 bool assembly_avx2::supported() {
   __builtin_cpu_init();
-  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  static const bool has = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && vector_kernels_allowed();
   return has;
 }
 #else

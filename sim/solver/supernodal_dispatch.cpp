@@ -4,6 +4,8 @@
 // is false and the portable Eigen path runs.
 #include "sim/solver/supernodal_kernels.hpp"
 
+#include "sim/core/kernel_choice.hpp"
+
 #include <cstdlib>
 
 #if defined(CLOTHSIM_X86_KERNELS)
@@ -18,7 +20,7 @@ bool supported() {
   // F16C through CPUID leaf 1 (ECX bit 29): clang 14's __builtin_cpu_supports does not know "f16c".
   unsigned eax = 0, ebx = 0, ecx = 0, edx = 0;
   const bool f16c = __get_cpuid(1, &eax, &ebx, &ecx, &edx) != 0 && (ecx & bit_F16C) != 0;
-  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && f16c;
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && f16c && vector_kernels_allowed();
 }
 #else
 bool supported() { return false; }
