@@ -111,5 +111,5 @@ def test_example_study_runs(tmp_path):
                             capture_output=True, text=True, env=dict(os.environ))
     assert result.returncode == 0, result.stderr
     rows = (tmp_path / "study.csv").read_text().strip().splitlines()
-    assert rows[0] == "preset,bending_rigidity,tip_sag_m,kinetic_J,elastic_J"
+    assert rows[0] == "preset,bending_rigidity,bending_length_m,tip_sag_m,kinetic_J,elastic_J"
     assert len(rows) >= 3
