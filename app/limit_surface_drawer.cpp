@@ -160,9 +160,13 @@ render::Camera LimitSurfaceDrawer::camera(const render::Vec3f& lo, const render:
     c.fov_deg = static_cast<float>(settings_.fov_deg);
     return c;
   }
-  // Looking along −z, a little from above, with +y up.
-  return render::frame_bounds(lo, hi, static_cast<float>(settings_.fov_deg), render::Vec3f{0.35f, -0.35f, -1.0f},
-                              render::Vec3f{0, 1, 0}, static_cast<float>(width_) / static_cast<float>(height_));
+  // With +y up: looking along −z, a little from above. Another up (render.up, by default opposite
+  // to gravity) turns that view with it, by the shortest rotation taking +y to it.
+  const Eigen::Vector3d up = settings_.world_up.normalized();
+  const Eigen::Vector3d view =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitY(), up) * Eigen::Vector3d(0.35, -0.35, -1.0);
+  return render::frame_bounds(lo, hi, static_cast<float>(settings_.fov_deg), to_vec3f(view), to_vec3f(up),
+                              static_cast<float>(width_) / static_cast<float>(height_));
 }
 
 render::Frame LimitSurfaceDrawer::frame(const SurfaceSnapshot& s, const render::Camera& camera,

@@ -325,7 +325,7 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   if (j == nullptr) return s;
   r.check_object(*j, "render",
                  {"width", "height", "refine", "color", "back_color", "background", "wireframe", "ground", "camera",
-                  "framing", "surface", "texture"});
+                  "framing", "surface", "texture", "up"});
   if (const Json* v = r.find(*j, "width")) s.width = r.integer_at_least(*v, "render.width", 16);
   if (const Json* v = r.find(*j, "height")) s.height = r.integer_at_least(*v, "render.height", 16);
   if (s.width > 8192 || s.height > 8192) r.fail("render", "images larger than 8192 px are not supported");
@@ -347,6 +347,12 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   if (const Json* v = r.find(*j, "wireframe")) s.wireframe = r.boolean(*v, "render.wireframe");
   if (const Json* v = r.find(*j, "texture")) s.texture = r.choice(*v, "render.texture", {"none", "grain", "checker"}, "texture");
   if (const Json* v = r.find(*j, "ground")) s.ground = r.boolean(*v, "render.ground");
+  if (const Json* v = r.find(*j, "up")) {
+    const Eigen::Vector3d up = r.vec3(*v, "render.up");
+    if (!(up.norm() > 0)) r.fail("render.up", "must not be the zero vector");
+    s.world_up = up.normalized();
+    s.up_given = true;
+  }
   if (const Json* v = r.find(*j, "surface")) {
     const std::string surface = r.choice(*v, "render.surface", {"method", "loop_limit", "flat"}, "surface");
     s.surface = surface == "loop_limit" ? DrawnSurface::loop_limit

@@ -23,6 +23,7 @@ nlohmann::ordered_json render_settings_json(const RenderSettings& s) {
                               {"ground", s.ground},
                               {"framing", s.framing == Framing::sequence ? "sequence" : "motion"}};
   if (s.texture != "none") j["texture"] = s.texture;  // (only when set: older outputs stay as they were)
+  if (s.world_up != Eigen::Vector3d(0, 1, 0)) j["up"] = vec3(s.world_up);  // likewise
   if (s.has_camera)
     j["camera"] = {{"eye", vec3(s.eye)}, {"target", vec3(s.target)}, {"up", vec3(s.up)}, {"fov_deg", s.fov_deg}};
   return j;
