@@ -651,8 +651,9 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
       read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, pattern ? &*pattern : nullptr, dynamic, say);
   read_loads(r, r.find(root, "loads"), scene.problem, pattern ? &*pattern : nullptr, dynamic ? &dyn.ramp_time : nullptr, say);
   check_load_magnitudes(r, scene.problem, say);
-  // The pictures' up: opposite to gravity unless the scene says (render.up).
-  if (!scene.render.up_given && scene.problem.gravity.norm() > 0)
+  // The pictures' up: opposite to gravity unless the scene says (render.up) — but +y with a ground,
+  // which is always the x–z plane below the cloth (seen from under it, it would hide the cloth).
+  if (!scene.render.up_given && scene.problem.gravity.norm() > 0 && !scene.render.ground)
     scene.render.world_up = -scene.problem.gravity.normalized();
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
   // The boundary and probes were selected on the mesh as placed; the imperfection then changes

@@ -60,8 +60,8 @@ struct RenderSettings {
   static constexpr double kCheckerCell = 0.05;  // [texture units: m for a pattern] side of a checker square
   bool ground = false;     // a ground plane at the bottom of the framed box (see `framing`)
   // "render.up": the direction that is up in an automatically framed picture (unit). Default:
-  // opposite to gravity, +y without gravity (a z-up scene is drawn upright); `up_given` when the
-  // scene sets it. A scene's own camera has its own up (render.camera.up).
+  // opposite to gravity, +y without gravity or with render.ground (the ground is the x–z plane);
+  // a z-up scene is drawn upright. `up_given` when the scene sets it. A scene's own camera has its own up (render.camera.up).
   Eigen::Vector3d world_up{0, 1, 0};
   bool up_given = false;
   bool has_camera = false;  // otherwise framed automatically, see `framing`

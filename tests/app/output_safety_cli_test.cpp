@@ -72,7 +72,7 @@ std::vector<std::string> temporaries(const fs::path& dir) {
 }
 
 TEST_F(OutputSafetyTest, ASecondRunIntoAFolderInUseIsRefusedNamingThePid) {
-  const fs::path scene = write_scene(0.6);
+  const fs::path scene = write_scene(2.0);  // long enough to be still running under load
   const fs::path out = dir_ / "out";
   const pid_t first = testing::spawn_process(CLOTHSIM_BINARY, {scene.string(), "--out", out.string(), "--no-render"}, dir_ / "first.txt");
   ASSERT_GT(first, 0);
@@ -91,10 +91,10 @@ TEST_F(OutputSafetyTest, ASecondRunIntoAFolderInUseIsRefusedNamingThePid) {
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << read_file_bytes(dir_ / "first.txt");
   const std::string summary = read_file_bytes(out / "hang" / "summary.json");
   EXPECT_NE(summary.find("\"status\": \"completed\""), std::string::npos);
-  EXPECT_NE(summary.find("\"frames\": 19"), std::string::npos) << summary;  // 0.6 s at 30 fps: frames 0..18
+  EXPECT_NE(summary.find("\"frames\": 61"), std::string::npos) << summary;  // 2 s at 30 fps: frames 0..60
   int objs = 0;
   for (const auto& e : fs::directory_iterator(out / "hang" / "frames")) objs += e.path().extension() == ".obj";
-  EXPECT_EQ(objs, 19);
+  EXPECT_EQ(objs, 61);
   EXPECT_FALSE(fs::exists(out / "hang" / "frame_0000.png")) << "a PNG of the refused run (the first has --no-render)";
   EXPECT_FALSE(fs::exists(out / ".hang.lock")) << "the lock file goes with its run";
 

@@ -4,6 +4,7 @@
 #include "sim/mesh/obj_io.hpp"
 
 #include "tests/support/cli_fixture.hpp"
+#include "tests/support/skirt_scene.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -16,15 +17,8 @@ namespace {
 class PatternCli : public testing::CliFixture {};
 
 // The tube skirt of scenes/README.md, no body, a few steps.
-const char* const kSkirt = R"({"name": "skirt", "analysis": "dynamic",
-  "mesh": {"pattern": {"edge_length": 0.05, "pieces": [
-    {"name": "front", "points": [[-0.25, 0.0], [0.25, 0.0], [0.25, 0.5], [-0.25, 0.5]],
-     "placement": {"wrap": {"radius": 0.17}, "translate": [0, 0.45, 0]}},
-    {"name": "back", "points": [[-0.25, 0.0], [0.25, 0.0], [0.25, 0.5], [-0.25, 0.5]],
-     "placement": {"wrap": {"radius": 0.17}, "rotate_deg": [0, 180, 0], "translate": [0, 0.45, 0]}}],
-    "seams": [{"a": {"piece": "front", "edge": 1}, "b": {"piece": "back", "edge": 3}, "reversed": true},
-              {"a": {"piece": "front", "edge": 3}, "b": {"piece": "back", "edge": 1}, "reversed": true}]}},
-  "material": {"preset": "cotton"}, "settle": {"time": 0.05},
+const std::string kSkirt = std::string(R"({"name": "skirt", "analysis": "dynamic", )") + testing::kCoarseTubeSkirtMesh +
+                          R"(, "material": {"preset": "cotton"}, "settle": {"time": 0.05},
   "time": {"dt": 0.01, "end": 0.02, "output_fps": 50}, "output": {"obj": true, "obj_level": LEVEL}})";
 
 double uv_area(const TriMesh& m) {

@@ -45,6 +45,9 @@ TEST(PictureUp, OppositeToGravityByDefault) {
   expect_upright(auto_camera(""), Eigen::Vector3d::UnitY());  // no gravity: +y
   expect_upright(auto_camera(R"(, "loads": {"gravity": [0, 0, -9.81]}, "render": {"up": [1, 0, 0]})"),
                  Eigen::Vector3d::UnitX());
+  // With a ground (the x–z plane below the cloth) +y stays up, or the ground would hide the cloth.
+  expect_upright(auto_camera(R"(, "loads": {"gravity": [0, 0, -9.81]}, "render": {"ground": true})"),
+                 Eigen::Vector3d::UnitY());
 }
 
 TEST(PictureUp, AYUpSceneKeepsItsCamera) {

@@ -49,6 +49,16 @@ std::string without_times(const std::string& csv) {
   return out;
 }
 
+// The commands of a plan's tasks.tsv, in its order (the last column of every line but the header).
+std::vector<std::string> task_commands(const fs::path& plan) {
+  std::vector<std::string> commands;
+  std::istringstream in(read_file_bytes(plan / "tasks.tsv"));
+  std::string line;
+  std::getline(in, line);
+  while (std::getline(in, line)) commands.push_back(line.substr(line.rfind('\t') + 1));
+  return commands;
+}
+
 class StudySweepCli : public CliFixture {
  protected:
   // A stand-in for sbatch on PATH (dir_/bin): `sbatch --parsable [--wait] SCRIPT` prints job id 42 and
@@ -94,13 +104,7 @@ TEST_F(StudySweepCli, LocalJobsAndPlanTaskGatherGiveTheSerialResults) {
   ASSERT_EQ(planned.exit_code, 0) << planned.err;
   EXPECT_TRUE(contains(planned.out, "planned 4 tasks")) << planned.out;
   EXPECT_FALSE(fs::exists(dir_ / "byhand")) << "planning ran something";
-  std::vector<std::string> commands;
-  {
-    std::istringstream in(read_file_bytes(plan / "tasks.tsv"));
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) commands.push_back(line.substr(line.rfind('\t') + 1));
-  }
+  const std::vector<std::string> commands = task_commands(plan);
   ASSERT_EQ(commands.size(), 4u);
   EXPECT_EQ(commands[0].rfind(std::string(CLOTHSIM_BINARY) + " task ", 0), 0u) << commands[0];
   for (auto it = commands.rbegin(); it != commands.rend(); ++it)
@@ -300,13 +304,7 @@ TEST_F(StudySweepCli, ConvergenceTasksGiveTheOneProcessResults) {
   const fs::path plan = dir_ / "plan";
   const CliResult planned = run("study convergence --quick --no-plot --plan " + q(plan) + " --out " + q(dir_ / "tasks"));
   ASSERT_EQ(planned.exit_code, 0) << planned.err;
-  std::vector<std::string> commands;
-  {
-    std::istringstream in(read_file_bytes(plan / "tasks.tsv"));
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) commands.push_back(line.substr(line.rfind('\t') + 1));
-  }
+  const std::vector<std::string> commands = task_commands(plan);
   ASSERT_GT(commands.size(), 5u);
   for (auto it = commands.rbegin(); it + 1 != commands.rend(); ++it)  // all but the first
     ASSERT_EQ(run_shell(*it + " >/dev/null 2>&1"), 0) << *it;
