@@ -227,7 +227,7 @@ const SweepHooks& sweep_hooks(const std::string& name) {
   if (name == "stability") return stability_sweep_hooks();
   if (name == "convergence") return convergence_sweep_hooks();
   if (name == "figures") return figures_sweep_hooks();
-  throw std::invalid_argument("\"" + name + "\" cannot be run as tasks (folds, stability and figures can)");
+  throw std::invalid_argument("\"" + name + "\" cannot be run as tasks (folds, stability, convergence and figures can)");
 }
 
 std::filesystem::path find_on_path(const std::string& name) {

@@ -63,13 +63,83 @@ void check_travel(const Reader& r, const Motion& m, const std::string& path, con
                                              " m, its bounding-box diagonal); is the unit metres?");
 }
 
-// `select`: {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} → the control vertices in the
-// closed box (at least one).
-// A boundary's or a load's "select": {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} (the
-// vertices inside it) or, on a pattern garment, {"piece_edge": {"piece": name, "edge": i or
-// [first, last]}} (the vertices along the piece's edge or path of edges) or {"piece": {"name":
-// name, "box": [[umin, vmin], [umax, vmax]]}} (the piece's vertices, those whose pattern
-// coordinates lie in the closed box if one is given: a vertex group drawn on the pattern).
+// `v` sorted, each vertex once.
+std::vector<int> sorted_unique(std::vector<int> v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  return v;
+}
+
+// {"piece_edge": {"piece": name, "edge": i or [first, last]}} at `path`: the vertices along the
+// piece's edge or path of edges.
+std::vector<int> select_piece_edge(const Reader& r, const Json& j, const std::string& path, const SewnPattern& pattern) {
+  const SeamSide side = read_piece_edge(r, j, path, pattern.spec);
+  std::size_t piece = 0;
+  while (pattern.spec.pieces[piece].name != side.piece) ++piece;
+  const auto& edges = pattern.built.edge_vertices[piece];
+  const int n = static_cast<int>(edges.size());
+  std::vector<int> vertices;
+  for (int e = side.first_edge;; e = (e + 1) % n) {
+    vertices.insert(vertices.end(), edges[static_cast<std::size_t>(e)].begin(), edges[static_cast<std::size_t>(e)].end());
+    if (e == side.last_edge) break;
+  }
+  return sorted_unique(std::move(vertices));
+}
+
+// {"piece": {"name": name, "box": [[umin, vmin], [umax, vmax]]}} at `path`: the piece's vertices,
+// those whose pattern coordinates lie in the closed box if one is given (a vertex group drawn on
+// the pattern); at least one.
+std::vector<int> select_piece_region(const Reader& r, const Json& j, const std::string& path, const SewnPattern& pattern) {
+  r.check_object(j, path, {"name", "box"});
+  const std::size_t piece = read_piece_name(r, r.require(j, path, "name"), join_key(path, "name"), pattern.spec);
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(-std::numeric_limits<double>::infinity()), hi = -lo;
+  const std::string box_path = join_key(path, "box");
+  if (const Json* box = r.find(j, "box")) {
+    if (!box->is_array() || box->size() != 2)
+      r.fail(box_path, "expected an array of 2 points [[umin, vmin], [umax, vmax]] in the piece's pattern coordinates [m] "
+                       "(got " + describe(*box) + ")");
+    for (int c = 0; c < 2; ++c) {
+      const std::string corner = join_index(box_path, c);
+      const Json& p = (*box)[static_cast<std::size_t>(c)];
+      if (!p.is_array() || p.size() != 2) r.fail(corner, "expected [u, v] [m] (got " + describe(p) + ")");
+      (c == 0 ? lo : hi) = Eigen::Vector2d(r.number(p[0], join_index(corner, 0)), r.number(p[1], join_index(corner, 1)));
+    }
+    for (int k = 0; k < 2; ++k)
+      if (lo[k] > hi[k])
+        r.fail(box_path, "min must be <= max in u and v (got " + format_number(lo[k]) + " > " + format_number(hi[k]) + ")");
+  }
+  const PatternMesh& built = pattern.built;
+  std::vector<int> vertices;
+  for (std::size_t t = 0; t < built.triangle_piece.size(); ++t) {
+    if (built.triangle_piece[t] != static_cast<int>(piece)) continue;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const Eigen::Vector2d& uv = built.mesh.uv[t][c];
+      if ((uv.array() >= lo.array()).all() && (uv.array() <= hi.array()).all()) vertices.push_back(built.mesh.triangles[t][c]);
+    }
+  }
+  if (vertices.empty()) r.fail(box_path, "selects no vertex of piece " + quote(pattern.spec.pieces[piece].name));
+  return sorted_unique(std::move(vertices));
+}
+
+// {"box": [[xmin, ymin, zmin], [xmax, ymax, zmax]]} at `path`: the control vertices in the closed
+// box (at least one).
+std::vector<int> select_in_box(const Reader& r, const Json& box, const std::string& path, const TriMesh& mesh) {
+  if (!box.is_array() || box.size() != 2)
+    r.fail(path, "expected an array of 2 points [[xmin, ymin, zmin], [xmax, ymax, zmax]] (got " + describe(box) + ")");
+  const Eigen::Vector3d lo = r.vec3(box[0], join_index(path, 0));
+  const Eigen::Vector3d hi = r.vec3(box[1], join_index(path, 1));
+  for (int k = 0; k < 3; ++k)
+    if (lo[k] > hi[k])
+      r.fail(path, std::string("min must be <= max in every component (got ") + kAxes[k] + "min = " +
+                       format_number(lo[k]) + " > " + kAxes[k] + "max = " + format_number(hi[k]) + ")");
+  std::vector<int> vertices = select_box(mesh.vertices, lo, hi);
+  if (vertices.empty())
+    r.fail(path, "selects no vertex of the mesh (mesh bounding box: " + bounding_box(mesh.vertices) + ")");
+  return vertices;
+}
+
+// A boundary's or a load's "select": one of "box" (select_in_box) or, on a pattern garment,
+// "piece_edge" (select_piece_edge) and "piece" (select_piece_region).
 std::vector<int> read_selection(const Reader& r, const Json& item, const std::string& path, const TriMesh& mesh,
                                 const SewnPattern* pattern) {
   const std::string select_path = join_key(path, "select");
@@ -77,74 +147,14 @@ std::vector<int> read_selection(const Reader& r, const Json& item, const std::st
   r.check_object(select, select_path, {"box", "piece_edge", "piece"});
   if (select.contains("box") + select.contains("piece_edge") + select.contains("piece") != 1)
     r.fail(select_path, "give one of \"box\", \"piece_edge\" and \"piece\"");
-  if (const Json* region = r.find(select, "piece")) {
-    const std::string region_path = join_key(select_path, "piece");
-    if (pattern == nullptr) r.fail(region_path, "needs a pattern mesh (\"mesh\": {\"pattern\": ...})");
-    r.check_object(*region, region_path, {"name", "box"});
-    const std::size_t piece = read_piece_name(r, r.require(*region, region_path, "name"), join_key(region_path, "name"),
-                                              pattern->spec);
-    Eigen::Vector2d lo = Eigen::Vector2d::Constant(-std::numeric_limits<double>::infinity()), hi = -lo;
-    const std::string box_path = join_key(region_path, "box");
-    if (const Json* box = r.find(*region, "box")) {
-      if (!box->is_array() || box->size() != 2)
-        r.fail(box_path, "expected an array of 2 points [[umin, vmin], [umax, vmax]] in the piece's pattern coordinates [m] "
-                         "(got " + describe(*box) + ")");
-      for (int c = 0; c < 2; ++c) {
-        const std::string corner = join_index(box_path, c);
-        const Json& p = (*box)[static_cast<std::size_t>(c)];
-        if (!p.is_array() || p.size() != 2) r.fail(corner, "expected [u, v] [m] (got " + describe(p) + ")");
-        (c == 0 ? lo : hi) = Eigen::Vector2d(r.number(p[0], join_index(corner, 0)), r.number(p[1], join_index(corner, 1)));
-      }
-      for (int k = 0; k < 2; ++k)
-        if (lo[k] > hi[k]) r.fail(box_path, "min must be <= max in u and v (got " + format_number(lo[k]) + " > " + format_number(hi[k]) + ")");
+  for (const char* key : {"piece_edge", "piece"})
+    if (const Json* j = r.find(select, key)) {
+      const std::string key_path = join_key(select_path, key);
+      if (pattern == nullptr) r.fail(key_path, "needs a pattern mesh (\"mesh\": {\"pattern\": ...})");
+      return std::string(key) == "piece" ? select_piece_region(r, *j, key_path, *pattern)
+                                         : select_piece_edge(r, *j, key_path, *pattern);
     }
-    const PatternMesh& built = pattern->built;
-    std::vector<int> vertices;
-    for (std::size_t t = 0; t < built.triangle_piece.size(); ++t) {
-      if (built.triangle_piece[t] != static_cast<int>(piece)) continue;
-      for (int c = 0; c < 3; ++c) {
-        const Eigen::Vector2d& uv = built.mesh.uv[t][static_cast<std::size_t>(c)];
-        if ((uv.array() >= lo.array()).all() && (uv.array() <= hi.array()).all())
-          vertices.push_back(built.mesh.triangles[t][static_cast<std::size_t>(c)]);
-      }
-    }
-    std::sort(vertices.begin(), vertices.end());
-    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-    if (vertices.empty()) r.fail(box_path, "selects no vertex of piece " + quote(pattern->spec.pieces[piece].name));
-    return vertices;
-  }
-  if (const Json* edge = r.find(select, "piece_edge")) {
-    const std::string edge_path = join_key(select_path, "piece_edge");
-    if (pattern == nullptr) r.fail(edge_path, "needs a pattern mesh (\"mesh\": {\"pattern\": ...})");
-    const SeamSide side = read_piece_edge(r, *edge, edge_path, pattern->spec);
-    std::size_t piece = 0;
-    while (pattern->spec.pieces[piece].name != side.piece) ++piece;
-    const auto& edges = pattern->built.edge_vertices[piece];
-    const int n = static_cast<int>(edges.size());
-    std::vector<int> vertices;
-    for (int e = side.first_edge;; e = (e + 1) % n) {
-      vertices.insert(vertices.end(), edges[static_cast<std::size_t>(e)].begin(), edges[static_cast<std::size_t>(e)].end());
-      if (e == side.last_edge) break;
-    }
-    std::sort(vertices.begin(), vertices.end());
-    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
-    return vertices;
-  }
-  const std::string box_path = join_key(select_path, "box");
-  const Json& box = select["box"];
-  if (!box.is_array() || box.size() != 2)
-    r.fail(box_path, "expected an array of 2 points [[xmin, ymin, zmin], [xmax, ymax, zmax]] (got " +
-                         describe(box) + ")");
-  const Eigen::Vector3d lo = r.vec3(box[0], join_index(box_path, 0));
-  const Eigen::Vector3d hi = r.vec3(box[1], join_index(box_path, 1));
-  for (int k = 0; k < 3; ++k)
-    if (lo[k] > hi[k])
-      r.fail(box_path, std::string("min must be <= max in every component (got ") + kAxes[k] + "min = " +
-                           format_number(lo[k]) + " > " + kAxes[k] + "max = " + format_number(hi[k]) + ")");
-  std::vector<int> vertices = select_box(mesh.vertices, lo, hi);
-  if (vertices.empty())
-    r.fail(box_path, "selects no vertex of the mesh (mesh bounding box: " + bounding_box(mesh.vertices) + ")");
-  return vertices;
+  return select_in_box(r, select["box"], join_key(select_path, "box"), mesh);
 }
 
 std::vector<BoundaryCondition> read_boundary(const Reader& r, const Json* j, const TriMesh& mesh,
