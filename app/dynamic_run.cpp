@@ -558,7 +558,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
         const SurfaceSnapshot rest = drawer->snapshot(sim->discretization().rest());
         Bounds b;
         LimitSurfaceDrawer::extend_bounds(rest, b.lo, b.hi);
-        (void)renderer->render(drawer->frame(rest, drawer->camera(b.lo, b.hi), b.lo[1]));
+        (void)renderer->render(drawer->frame(rest, drawer->camera(b.lo, b.hi), b.lo, b.hi));
         render_seconds_per_frame = seconds_since(t0);
       }
     } catch (const std::exception& e) {

@@ -159,7 +159,7 @@ void FrameImages::add(const Eigen::VectorXd& x, double t, int step) {
     hand_over(Job{frames_, step, false, drawer_.snapshot(x, t)});
   } else if (framing_ == Framing::motion) {
     try {
-      last_image_ = renderer_.render(drawer_.frame(drawer_.snapshot(x, t), camera_, bounds_.lo[1]));
+      last_image_ = renderer_.render(drawer_.frame(drawer_.snapshot(x, t), camera_, bounds_.lo, bounds_.hi));
       write_picture(*last_image_, frames_);
     } catch (const std::exception& e) {
       throw FramePictureError(e.what(), step);
@@ -233,7 +233,7 @@ void FrameImages::draw_pictures() {
       queue_.pop_front();
     }
     try {
-      if (!job.repeat) drawn_last_ = renderer_.render(drawer_.frame(job.surface, camera_, bounds_.lo[1]));
+      if (!job.repeat) drawn_last_ = renderer_.render(drawer_.frame(job.surface, camera_, bounds_.lo, bounds_.hi));
       job.surface = SurfaceSnapshot{};
       write_picture(drawn_last_, job.frame);
       std::lock_guard lock(mutex_);
@@ -287,7 +287,7 @@ int FrameImages::finish(bool keep_spool) {
       in.read(reinterpret_cast<char*>(&t), sizeof(double));
       in.read(reinterpret_cast<char*>(positions.data()), static_cast<std::streamsize>(positions.size() * sizeof(double)));
       if (!in) throw std::runtime_error(path.string() + ": cannot read frame " + std::to_string(frame));
-      write_picture(renderer_.render(drawer_.frame(drawer_.snapshot(positions, t), camera, bounds_.lo[1])), frame);
+      write_picture(renderer_.render(drawer_.frame(drawer_.snapshot(positions, t), camera, bounds_.lo, bounds_.hi)), frame);
       ++written_;
     }
   }

@@ -98,7 +98,8 @@ void LimitSurfaceDrawer::set_obstacles(const std::vector<Obstacle>& obstacles) {
   for (const Obstacle& o : obstacles) {
     if (o.shape == Obstacle::Shape::plane) {
       planes_.push_back(o);
-      if (ground_plane_ < 0 && std::abs(o.normal.y()) > 0.999) ground_plane_ = static_cast<int>(planes_.size()) - 1;
+      if (ground_plane_ < 0 && std::abs(o.normal.normalized().dot(settings_.world_up.normalized())) > 0.999)
+        ground_plane_ = static_cast<int>(planes_.size()) - 1;
       continue;
     }
     for (const Triangle& t : o.mesh.triangles)
@@ -138,7 +139,7 @@ SurfaceSnapshot LimitSurfaceDrawer::snapshot(const Eigen::VectorXd& x, double t)
   if (ground_plane_ >= 0) {
     Eigen::Vector3d point, normal;
     plane_at(planes_[static_cast<std::size_t>(ground_plane_)], t, point, normal);
-    s.plane_height = static_cast<float>(point.y());
+    s.plane_height = static_cast<float>(point.dot(settings_.world_up.normalized()));
   }
   return s;
 }
@@ -170,7 +171,7 @@ render::Camera LimitSurfaceDrawer::camera(const render::Vec3f& lo, const render:
 }
 
 render::Frame LimitSurfaceDrawer::frame(const SurfaceSnapshot& s, const render::Camera& camera,
-                                        float ground_height) const {
+                                        const render::Vec3f& lo, const render::Vec3f& hi) const {
   render::Frame f;
   f.width = width_;
   f.height = height_;
@@ -214,8 +215,20 @@ render::Frame LimitSurfaceDrawer::frame(const SurfaceSnapshot& s, const render::
     obstacles.back_color = {0.35f, 0.38f, 0.45f};
     f.meshes.push_back(std::move(obstacles));
   }
+  const Eigen::Vector3d up = settings_.world_up.normalized();
+  double lowest = std::numeric_limits<double>::infinity();  // the box's lowest corner along up
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3d corner((c & 1) != 0 ? hi[0] : lo[0], (c & 2) != 0 ? hi[1] : lo[1], (c & 4) != 0 ? hi[2] : lo[2]);
+    lowest = std::min(lowest, corner.dot(up));
+  }
+  // Nothing drawn pierces it: an obstacle reaching below the box (the sequence framing's box
+  // holds the cloth only) takes the ground down with it.
+  for (std::size_t i = 0; i + 2 < s.obstacles.size(); i += 3)
+    lowest = std::min(lowest, up.x() * s.obstacles[i] + up.y() * s.obstacles[i + 1] + up.z() * s.obstacles[i + 2]);
   f.ground = settings_.ground || ground_plane_ >= 0;
-  f.ground_height = ground_plane_ >= 0 ? s.plane_height : ground_height;
+  f.ground_height = ground_plane_ >= 0 ? s.plane_height : static_cast<float>(lowest);
+  f.up = to_vec3f(up);
+  f.shadow = settings_.shadow;
   return f;
 }
 

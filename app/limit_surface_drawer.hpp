@@ -29,7 +29,7 @@ struct SurfaceSnapshot {
   std::vector<float> normals;    // unit normals, 3 per fine vertex
   std::vector<float> control;    // control mesh vertices (wireframe), 3 per vertex [m]
   std::vector<float> obstacles;  // the obstacles' mesh vertices at the frame's time, 3 per vertex [m]
-  float plane_height = 0.0f;     // y of a horizontal plane obstacle at the frame's time [m]
+  float plane_height = 0.0f;     // height along render.up of the ground plane obstacle at the frame's time [m]
   std::vector<float> grain;      // render.texture "grain": two end points per control triangle [m]
 };
 
@@ -39,7 +39,8 @@ class LimitSurfaceDrawer {
   LimitSurfaceDrawer(const Discretization& discretization, const RenderSettings& settings, int width, int height);
 
   // Obstacles drawn with the cloth: the meshes of every non-plane obstacle (the geometry that
-  // collides), and a horizontal plane (normal ±y) as the ground; other planes are not drawn.
+  // collides), and a plane whose normal is ± the pictures' up (render.up, by default opposite
+  // to gravity) as the ground; other planes are not drawn.
   void set_obstacles(const std::vector<Obstacle>& obstacles);
   // `x`: node positions (3·#nodes, flat) [m] at time `t` [s] (where the obstacles are).
   SurfaceSnapshot snapshot(const Eigen::VectorXd& x, double t = 0.0) const;
@@ -47,9 +48,14 @@ class LimitSurfaceDrawer {
   static void extend_bounds(const SurfaceSnapshot& s, render::Vec3f& lo, render::Vec3f& hi);
   // The scene's camera, or one that frames the box [lo, hi] (viewed slightly from above).
   render::Camera camera(const render::Vec3f& lo, const render::Vec3f& hi) const;
-  // `ground_height`: y of the ground plane (when render.ground), e.g. the sequence's lowest y; a
-  // horizontal plane obstacle is drawn as the ground at its own height instead.
-  render::Frame frame(const SurfaceSnapshot& s, const render::Camera& camera, float ground_height) const;
+  // With render.ground the ground is the plane normal to render.up through the lowest corner
+  // of the box [lo, hi] (the framed box: the sequence's, or the one known before a run) or the
+  // lowest obstacle vertex of the snapshot if that lies lower (so no obstacle pierces it), with
+  // the cloth's and the obstacles' shadow unless render.shadow is false; a plane obstacle normal
+  // to render.up is drawn as the ground at its own height instead (with or without
+  // render.ground).
+  render::Frame frame(const SurfaceSnapshot& s, const render::Camera& camera, const render::Vec3f& lo,
+                      const render::Vec3f& hi) const;
 
   int fine_triangles() const { return static_cast<int>(triangles_.size() / 3); }
 

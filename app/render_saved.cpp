@@ -155,7 +155,7 @@ int render_saved_run(const fs::path& dir, const RenderSavedOptions& options) {
         if (mesh.triangles != first_triangles)  // changed since the first pass
           throw std::runtime_error(shape.obj.string() + ": its triangles differ from " + shapes.front().obj.string());
         const SurfaceSnapshot snapshot = drawer->snapshot(to_flat(mesh.vertices));
-        render::write_png((staging / shape.png).string(), renderer.render(drawer->frame(snapshot, camera, lo[1])));
+        render::write_png((staging / shape.png).string(), renderer.render(drawer->frame(snapshot, camera, lo, hi)));
         ++written;
       }
       nlohmann::ordered_json record = {

@@ -260,7 +260,7 @@ int run_scene_file(const fs::path& scene_file, const fs::path& out_root, const R
       render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
       LimitSurfaceDrawer::extend_bounds(snapshot, lo, hi);
       render::Renderer renderer(scene.render.width, scene.render.height);
-      picture = renderer.render(drawer.frame(snapshot, drawer.camera(lo, hi), lo[1]));
+      picture = renderer.render(drawer.frame(snapshot, drawer.camera(lo, hi), lo, hi));
     }
     try {
       publish(out_root, scene.name, [&](const fs::path& dir) {

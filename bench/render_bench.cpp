@@ -1,6 +1,6 @@
 // render_bench: time to render one 1280 x 720 frame with 4x MSAA of a smooth ~50k-triangle
 // mesh (a finely tessellated wavy cylinder generated here) over a ground plane, with and without
-// a wireframe overlay (BM_render_1280x720_msaa4: Renderer::render, i.e. everything from the Frame to the RGB
+// a wireframe overlay, and with the mesh's shadow on the ground (BM_render_1280x720_msaa4: Renderer::render, i.e. everything from the Frame to the RGB
 // image in memory, no PNG). BM_render_phases splits the same work into its phases
 // (RenderPhases, with glFinish between them; counters in ms per frame), BM_write_png times the
 // PNG encoding and writing of the rendered frame (write_png into a temporary folder), which a
@@ -73,12 +73,13 @@ Lines ring_lines(const Mesh& mesh, int every) {
   return lines;
 }
 
-Frame bench_frame(bool wireframe) {
+Frame bench_frame(bool wireframe, bool shadow = false) {
   Frame frame;
   frame.meshes.push_back(wavy_cylinder());
   if (wireframe) frame.lines.push_back(ring_lines(frame.meshes[0], 8));
   frame.ground = true;
   frame.ground_height = 0;
+  frame.shadow = shadow;
   frame.width = kWidth;
   frame.height = kHeight;
   frame.camera = frame_bounds({-0.65f, 0, -0.65f}, {0.65f, 1.8f, 0.65f}, 35, {-0.5f, -0.45f, -1},
@@ -92,7 +93,7 @@ Renderer& renderer() {
 }
 
 void BM_render_1280x720_msaa4(benchmark::State& state) {
-  const Frame frame = bench_frame(state.range(0) != 0);
+  const Frame frame = bench_frame(state.range(0) != 0, state.range(1) != 0);
   benchmark::DoNotOptimize(renderer().render(frame));  // warm-up: framebuffers, JIT
   for (auto _ : state) {
     Image image = renderer().render(frame);
@@ -102,9 +103,10 @@ void BM_render_1280x720_msaa4(benchmark::State& state) {
   state.counters["samples"] = renderer().info().samples;
 }
 BENCHMARK(BM_render_1280x720_msaa4)
-    ->ArgName("wireframe")
-    ->Arg(0)
-    ->Arg(1)
+    ->ArgNames({"wireframe", "shadow"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({0, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0)
     ->Repetitions(7)
@@ -114,7 +116,7 @@ BENCHMARK(BM_render_1280x720_msaa4)
 // The phases of render() (RenderPhases), with glFinish between them: counters in ms per frame
 // (the iteration time is their sum plus the timing's own overhead).
 void BM_render_phases(benchmark::State& state) {
-  const Frame frame = bench_frame(state.range(0) != 0);
+  const Frame frame = bench_frame(state.range(0) != 0, state.range(1) != 0);
   benchmark::DoNotOptimize(renderer().render(frame));
   renderer().set_phase_timing(true);
   RenderPhases sum;
@@ -123,6 +125,7 @@ void BM_render_phases(benchmark::State& state) {
     benchmark::DoNotOptimize(image.rgb.data());
     const RenderPhases& p = renderer().last_phases();
     sum.prepare += p.prepare;
+    sum.shadow += p.shadow;
     sum.backdrop += p.backdrop;
     sum.restore += p.restore;
     sum.upload += p.upload;
@@ -135,6 +138,7 @@ void BM_render_phases(benchmark::State& state) {
   renderer().set_phase_timing(false);
   const double n = static_cast<double>(state.iterations());
   state.counters["prepare_ms"] = sum.prepare / n;
+  state.counters["shadow_ms"] = sum.shadow / n;
   state.counters["backdrop_ms"] = sum.backdrop / n;
   state.counters["restore_ms"] = sum.restore / n;
   state.counters["upload_ms"] = sum.upload / n;
@@ -145,8 +149,9 @@ void BM_render_phases(benchmark::State& state) {
   state.counters["convert_ms"] = sum.convert / n;
 }
 BENCHMARK(BM_render_phases)
-    ->ArgName("wireframe")
-    ->Arg(0)
+    ->ArgNames({"wireframe", "shadow"})
+    ->Args({0, 0})
+    ->Args({0, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(1.0)
     ->Repetitions(7)
@@ -178,7 +183,7 @@ int main(int argc, char** argv) {
   for (int k = 0; k < argc; ++k) {
     if (std::strncmp(argv[k], "--png=", 6) == 0) {
       const std::string path = argv[k] + 6;
-      write_png(path, renderer().render(bench_frame(true)));
+      write_png(path, renderer().render(bench_frame(true, true)));
       std::cout << "wrote " << path << "\n";
     } else {
       rest.push_back(argv[k]);

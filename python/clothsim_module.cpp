@@ -141,7 +141,7 @@ class Simulation {
     render::Vec3f lo{1e30f, 1e30f, 1e30f}, hi{-1e30f, -1e30f, -1e30f};
     LimitSurfaceDrawer::extend_bounds(snapshot, lo, hi);
     render::Renderer renderer(w, h);
-    const render::Image image = renderer.render(drawer.frame(snapshot, drawer.camera(lo, hi), lo[1]));
+    const render::Image image = renderer.render(drawer.frame(snapshot, drawer.camera(lo, hi), lo, hi));
     py::array_t<std::uint8_t> out({static_cast<py::ssize_t>(h), static_cast<py::ssize_t>(w), static_cast<py::ssize_t>(3)});
     std::memcpy(out.mutable_data(), image.rgb.data(), image.rgb.size());
     return out;

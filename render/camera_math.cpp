@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -136,19 +137,45 @@ Camera frame_bounds(const Vec3f& lo, const Vec3f& hi, float fov_deg, Vec3f view_
   if (!(aspect > 0) || !std::isfinite(aspect)) {
     throw std::invalid_argument("frame_bounds: aspect must be positive");
   }
-  const Vec3d centre = 0.5 * (l + h);
-  double radius = 0.5 * norm(h - l);
-  if (!(radius > 0)) radius = 1e-3;  // a point: frame a tiny sphere around it
+  // The tightest eye position along the viewing direction that keeps all eight corners inside
+  // the frustum whose half-angle tangents are shrunk by the margin, the projected box centred in
+  // the binding direction. In camera coordinates (r, u, f: right, up, forward) a corner c is
+  // inside iff |c_r − e_r| ≤ t_h (c_f − e_f) and |c_u − e_u| ≤ t_v (c_f − e_f); for the
+  // horizontal pair that reads e_r − t_h e_f ≥ A = max(c_r − t_h c_f) and
+  // −e_r − t_h e_f ≥ B = max(−c_r − t_h c_f), so the eye can come forward to
+  // e_f = −(A + B) / (2 t_h), centred at e_r = (A − B) / 2 (likewise vertically); the smaller of
+  // the two e_f binds, and the other direction keeps its centre.
+  Vec3d lo_box = l, hi_box = h;
+  if (!(norm(h - l) > 0)) {  // a point: frame a tiny box around it
+    lo_box = l - 1e-3 * Vec3d{1, 1, 1};
+    hi_box = h + 1e-3 * Vec3d{1, 1, 1};
+  }
+  const Vec3d centre = 0.5 * (lo_box + hi_box);
   const double half_v = 0.5 * static_cast<double>(fov_deg) * std::numbers::pi / 180.0;
-  const double half_h = std::atan(std::tan(half_v) * static_cast<double>(aspect));
   const double margin = 1.05;
-  const double distance = margin * radius / std::sin(std::min(half_v, half_h));
-  const Vec3d eye = centre - (distance / norm(dir)) * dir;
+  const double t_v = std::tan(half_v) / margin;
+  const double t_h = std::tan(half_v) * static_cast<double>(aspect) / margin;
   const Basis b = camera_basis(dir, to_d(up));
+  const Vec3d f = -1.0 * b.back;
+  const double inf = std::numeric_limits<double>::infinity();
+  double a_h = -inf, b_h = -inf, a_v = -inf, b_v = -inf;
+  for (int i = 0; i < 8; ++i) {
+    const Vec3d c{(i & 1) != 0 ? hi_box.x : lo_box.x, (i & 2) != 0 ? hi_box.y : lo_box.y,
+                  (i & 4) != 0 ? hi_box.z : lo_box.z};
+    const double cr = dot(c, b.right), cu = dot(c, b.up), cf = dot(c, f);
+    a_h = std::max(a_h, cr - t_h * cf);
+    b_h = std::max(b_h, -cr - t_h * cf);
+    a_v = std::max(a_v, cu - t_v * cf);
+    b_v = std::max(b_v, -cu - t_v * cf);
+  }
+  const double e_f = std::min(-(a_h + b_h) / (2 * t_h), -(a_v + b_v) / (2 * t_v));
+  const Vec3d eye = 0.5 * (a_h - b_h) * b.right + 0.5 * (a_v - b_v) * b.up + e_f * f;
+  // The target: on the axis, as deep as the box centre.
+  const Vec3d target = eye + (dot(centre, f) - e_f) * f;
   Camera camera;
   camera.eye = {static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z)};
-  camera.target = {static_cast<float>(centre.x), static_cast<float>(centre.y),
-                   static_cast<float>(centre.z)};
+  camera.target = {static_cast<float>(target.x), static_cast<float>(target.y),
+                   static_cast<float>(target.z)};
   camera.up = {static_cast<float>(b.up.x), static_cast<float>(b.up.y), static_cast<float>(b.up.z)};
   camera.fov_deg = fov_deg;
   return camera;

@@ -30,9 +30,10 @@ struct PixelPosition {
 PixelPosition project_to_pixel(const Camera& camera, int width, int height, const Vec3f& point);
 
 // A camera looking along `view_direction` (from the eye towards the scene) that frames the
-// axis-aligned box [lo, hi]: the box's bounding sphere fits in both the vertical field of view
-// `fov_deg` and the horizontal one for the image aspect ratio `aspect` (= width / height), with
-// a small margin. Use it to fix one camera for a whole animation. If `up` is parallel to the
+// axis-aligned box [lo, hi]: the camera comes as close as the box's eight corners allow while
+// they stay inside both the vertical field of view `fov_deg` and the horizontal one for the
+// image aspect ratio `aspect` (= width / height), with a 5 % margin, and the projected box is
+// centred (so the box fills the image in the direction that binds). Use it to fix one camera for a whole animation. If `up` is parallel to the
 // view direction another up vector is chosen. Throws std::invalid_argument for a zero or
 // non-finite view direction, non-finite bounds, fov_deg outside (0, 180) or a non-positive
 // aspect.

@@ -44,11 +44,16 @@ struct Frame {
   std::vector<Lines> lines;
   Camera camera;
   Vec3f background{1, 1, 1};
-  // A large matte light grey plane y = ground_height, centred below the camera target, sized
-  // from the eye-target distance and fading into the background towards its edge (so it is the
-  // same in every frame of an animation with a fixed camera).
+  // A large matte light grey plane {x : x · up = ground_height}, centred below the camera
+  // target, sized from the eye-target distance and fading into the background towards its edge
+  // (so it is the same in every frame of an animation with a fixed camera). `up` is the ground's
+  // normal, the side it is seen from; it need not be unit length.
   bool ground = false;
   float ground_height = 0;
+  Vec3f up{0, 1, 0};
+  // With a ground: the meshes cast a soft shadow on it (a shadow map of a directional light 30°
+  // off `up`, on the key light's side, filtered over about 1.5 % of the meshes' extent).
+  bool shadow = false;
   int width = 960;
   int height = 720;
 };

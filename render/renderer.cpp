@@ -5,9 +5,11 @@
 #include <GL/osmesa.h>  // includes GL/gl.h and GL/glext.h; GL_GLEXT_PROTOTYPES is set by CMake
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -37,8 +39,11 @@ void main() {
 // Back faces use the back colour and the flipped normal. Vertices without a usable normal fall
 // back to the facet normal from screen-space derivatives. The ground is matte and fades into
 // the background with distance from its centre.
-// The source is compiled twice, with GROUND defined as 0 (meshes) and as 1 (the ground), into
-// two programs: llvmpipe runs both sides of a branch under a mask, so one program with a
+// With SHADOW 1 the ground is darkened by the shadow map (u_shadow_map: the blurred fraction of
+// the light that the meshes hold back, looked up bilinearly where the ground point lies as the
+// light sees it). Where it is 0 the colour is exactly that without a shadow.
+// The source is compiled three times, with GROUND defined as 0 (meshes) and as 1 (the ground,
+// SHADOW 0 or 1), into separate programs: llvmpipe runs both sides of a branch under a mask, so one program with a
 // uniform switch shaded every pixel of the ground with the cloth's lighting too (and every
 // cloth pixel with the ground's fade). The arithmetic of each side is unchanged, and so is every
 // pixel (checked on render_bench's frame and on the runs' frames).
@@ -50,8 +55,13 @@ uniform vec3 u_front_color;
 uniform vec3 u_back_color;
 const bool kIsGround = GROUND != 0;
 uniform vec3 u_background;
-uniform vec2 u_ground_centre;
+uniform vec3 u_ground_centre;
 uniform vec2 u_ground_fade;
+#if SHADOW
+uniform sampler2D u_shadow_map;
+uniform mat4 u_light;             // world to shadow-map coordinates ([0, 1]^2 across the map)
+uniform float u_shadow_strength;  // the darkening where the light is held back completely
+#endif
 out vec4 o_color;
 
 const vec3 kKeyDirection = normalize(vec3(-0.45, 0.6, 0.75));
@@ -101,7 +111,11 @@ void main() {
   } else {
     // Matte and mostly ambient, so that it stays light grey from any viewing angle.
     color = base * (0.45 + 0.55 * max(dot(n, kKeyDirection), 0.0));
-    float d = distance(v_world_position.xz, u_ground_centre);
+#if SHADOW
+    vec4 s = u_light * vec4(v_world_position, 1.0);
+    color *= 1.0 - u_shadow_strength * texture(u_shadow_map, s.xy).r;
+#endif
+    float d = distance(v_world_position, u_ground_centre);
     color = mix(color, u_background, smoothstep(u_ground_fade.x, u_ground_fade.y, d));
   }
   o_color = vec4(clamp(color, 0.0, 1.0), 1.0);
@@ -123,12 +137,25 @@ void main() { o_color = vec4(u_color, 1.0); }
 
 constexpr float kGroundGrey = 0.92f;
 
+// The shadow: a square map of kShadowMapSize texels over the meshes as seen from the light,
+// which comes from kShadowTiltDeg off the ground's normal towards the key light. A texel is 1
+// where a mesh covers its centre; the map is then blurred by kShadowBlurPasses box filters of
+// radius kShadowBlurRadius texels (close to a Gaussian of σ ≈ 2.4 texels, about 1 % of the
+// meshes' extent, reaching 6 texels); kShadowStrength of the ground's light is taken where the
+// shadow is full.
+constexpr int kShadowMapSize = 256;
+constexpr int kShadowBlurRadius = 2;
+constexpr int kShadowBlurPasses = 3;
+constexpr int kShadowReach = kShadowBlurRadius * kShadowBlurPasses;
+constexpr double kShadowTiltDeg = 30;
+constexpr float kShadowStrength = 0.45f;
+
 // Triangles drawn per llvmpipe scene (see draw_mesh).
 constexpr std::size_t kTrianglesPerScene = 8192;
 
-std::string surface_fragment_source(bool ground) {
-  return std::string("#version 330 core\n#define GROUND ") + (ground ? "1" : "0") + "\n" +
-         kSurfaceFragmentShaderBody;
+std::string surface_fragment_source(bool ground, bool shadow) {
+  return std::string("#version 330 core\n#define GROUND ") + (ground ? "1" : "0") +
+         "\n#define SHADOW " + (shadow ? "1" : "0") + "\n" + kSurfaceFragmentShaderBody;
 }
 
 std::string gl_error_name(GLenum error) {
@@ -318,16 +345,212 @@ struct PixelRect {
 
 PixelRect whole(int width, int height) { return {0, 0, width, height}; }
 
+struct V3 {
+  double x = 0, y = 0, z = 0;
+};
+V3 operator+(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 operator*(double s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+double dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 cross(const V3& a, const V3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+V3 unit(const V3& a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
+V3 to_v3(const Vec3f& v) { return {v[0], v[1], v[2]}; }
+Vec3f to_f(const V3& v) {
+  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+}
+
+// A unit vector perpendicular to the unit vector n: n × (the axis least aligned with n).
+V3 perpendicular(const V3& n) {
+  const V3 axes[3] = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+  const V3* best = &axes[0];
+  for (const V3& a : axes) {
+    if (std::abs(dot(a, n)) < std::abs(dot(*best, n)) - 1e-12) best = &a;
+  }
+  return unit(cross(n, *best));
+}
+
+// The ground: the plane x · normal = height (normal the unit up), a square of half size
+// `half_size` centred at `centre` below the camera target, spanned by `e1` and `e2` (e1 × e2 =
+// −normal, so that its corners centre ∓ e1 ∓ e2 run counter-clockwise seen from above).
+struct Ground {
+  V3 normal{0, 1, 0};
+  double height = 0;
+  V3 centre;
+  double half_size = 0;
+  V3 e1{1, 0, 0}, e2{0, 0, 1};
+  std::array<V3, 4> corners() const {
+    const V3 a = half_size * e1, b = half_size * e2;
+    return {centre - a - b, centre - a + b, centre + a + b, centre + a - b};
+  }
+};
+
+Ground ground_of(const Frame& frame) {
+  Ground g;
+  g.normal = unit(to_v3(frame.up));
+  g.height = frame.ground_height;
+  const V3 target = to_v3(frame.camera.target);
+  g.centre = target - (dot(target, g.normal) - g.height) * g.normal;
+  // Sized from the viewing distance, so that it (and its fade) stays fixed while the camera does.
+  g.half_size = 12.0 * std::sqrt(dot(to_v3(frame.camera.eye) - target, to_v3(frame.camera.eye) - target));
+  g.e1 = perpendicular(g.normal);
+  g.e2 = cross(g.e1, g.normal);
+  return g;
+}
+
+// The shadow map's light: where it looks from, the map and where on the ground a shadow can
+// fall. `on` only with a ground, the shadow asked for, and triangles to cast it. The ground is
+// taken to lie below the meshes (as the renderer's callers place it), so a ground point is in
+// shadow iff a mesh lies on the ray from it towards the light: the map holds coverage, not
+// depth.
+struct ShadowSetup {
+  bool on = false;
+  Mat4f light{};                // world to map coordinates, [0, 1]^2 across the map
+  std::vector<float> map;       // kShadowMapSize² occlusion in [0, 1], row by row
+  std::array<V3, 4> footprint;  // ground points around every place the map is not 0
+};
+
+// Marks the texels whose centre lies in the triangle (a, b, c) given in texel units (most of a
+// refined surface's triangles are smaller than a texel and hold one centre or none).
+void cover_triangle(const double (&a)[2], const double (&b)[2], const double (&c)[2], std::vector<float>& map) {
+  const int n = kShadowMapSize;
+  const double lo_x = std::min(a[0], std::min(b[0], c[0])), hi_x = std::max(a[0], std::max(b[0], c[0]));
+  const double lo_y = std::min(a[1], std::min(b[1], c[1])), hi_y = std::max(a[1], std::max(b[1], c[1]));
+  // Texel centres k + 0.5 inside [lo, hi]: k from ceil(lo − 0.5) to floor(hi − 0.5).
+  const int i0 = std::max(0, static_cast<int>(std::ceil(lo_x - 0.5)));
+  const int i1 = std::min(n - 1, static_cast<int>(std::floor(hi_x - 0.5)));
+  if (i0 > i1) return;
+  const int j0 = std::max(0, static_cast<int>(std::ceil(lo_y - 0.5)));
+  const int j1 = std::min(n - 1, static_cast<int>(std::floor(hi_y - 0.5)));
+  if (j0 > j1) return;
+  const double area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+  if (area == 0) return;
+  const double sign = area > 0 ? 1.0 : -1.0;
+  auto edge = [sign](const double (&p)[2], const double (&q)[2], double x, double y) {
+    return sign * ((q[0] - p[0]) * (y - p[1]) - (q[1] - p[1]) * (x - p[0]));
+  };
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      const double x = i + 0.5, y = j + 0.5;
+      if (edge(a, b, x, y) >= 0 && edge(b, c, x, y) >= 0 && edge(c, a, x, y) >= 0) {
+        map[static_cast<std::size_t>(j) * n + static_cast<std::size_t>(i)] = 1;
+      }
+    }
+  }
+}
+
+// One box filter of radius kShadowBlurRadius (the sum, not the mean: integers stay exact) along
+// rows or columns, as a running sum; the texels beyond the edge count as 0.
+void box_sum(std::vector<int>& map, std::vector<int>& scratch, bool columns) {
+  const int n = kShadowMapSize, r = kShadowBlurRadius;
+  for (int line = 0; line < n; ++line) {
+    auto at = [&](int k) -> std::size_t {
+      return columns ? static_cast<std::size_t>(k) * n + static_cast<std::size_t>(line)
+                     : static_cast<std::size_t>(line) * n + static_cast<std::size_t>(k);
+    };
+    int sum = 0;
+    for (int k = 0; k < r && k < n; ++k) sum += map[at(k)];
+    for (int k = 0; k < n; ++k) {
+      if (k + r < n) sum += map[at(k + r)];
+      if (k - r - 1 >= 0) sum -= map[at(k - r - 1)];
+      scratch[at(k)] = sum;
+    }
+  }
+  map.swap(scratch);
+}
+
+ShadowSetup shadow_setup(const Frame& frame, const Mat4f& view, const Ground& ground) {
+  ShadowSetup setup;
+  // The key light's direction in the world (it is fixed in camera space, see the shader), its
+  // part along the ground, and the light kShadowTiltDeg off the normal on that side.
+  const V3 key_view = unit({-0.45, 0.6, 0.75});
+  const V3 right{view[0], view[4], view[8]}, up{view[1], view[5], view[9]}, back{view[2], view[6], view[10]};
+  const V3 key = key_view.x * right + key_view.y * up + key_view.z * back;
+  V3 side = key - dot(key, ground.normal) * ground.normal;
+  side = dot(side, side) > 1e-12 ? unit(side) : ground.e1;
+  const double tilt = kShadowTiltDeg * std::numbers::pi / 180.0;
+  const V3 towards_light = std::cos(tilt) * ground.normal + std::sin(tilt) * side;
+  const V3 lx = perpendicular(towards_light), ly = cross(towards_light, lx);
+  double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+  for (const Mesh& mesh : frame.meshes) {
+    if (mesh.triangles.empty()) continue;
+    for (std::size_t i = 0; i + 2 < mesh.positions.size(); i += 3) {
+      const V3 p{mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]};
+      const double x = dot(p, lx), y = dot(p, ly);
+      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+  }
+  if (!(x0 <= x1)) return setup;  // nothing casts
+  const double scale = std::max({std::abs(x0), std::abs(x1), std::abs(y0), std::abs(y1), 1e-30});
+  const double extent = std::max({x1 - x0, y1 - y0, 1e-6 * scale});
+  // The meshes lie kShadowReach + 2 texels inside the map's edges, so the blur is never cut.
+  const int pad = kShadowReach + 2;
+  const double texel = extent / (kShadowMapSize - 2 * pad);
+  const double half = 0.5 * kShadowMapSize * texel;
+  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+  const double ox = cx - half, oy = cy - half;  // the map's corner, in light coordinates
+  double m[16] = {};  // world to map, column-major
+  m[0] = lx.x / (2 * half), m[4] = lx.y / (2 * half), m[8] = lx.z / (2 * half), m[12] = -ox / (2 * half);
+  m[1] = ly.x / (2 * half), m[5] = ly.y / (2 * half), m[9] = ly.z / (2 * half), m[13] = -oy / (2 * half);
+  m[10] = 1, m[15] = 1;
+  for (std::size_t i = 0; i < 16; ++i) setup.light[i] = static_cast<float>(m[i]);
+  // Coverage, then the blur.
+  const auto n = static_cast<std::size_t>(kShadowMapSize);
+  setup.map.assign(n * n, 0.0f);
+  std::vector<double> texels;
+  for (const Mesh& mesh : frame.meshes) {
+    if (mesh.triangles.empty()) continue;
+    texels.resize(2 * (mesh.positions.size() / 3));
+    for (std::size_t v = 0; 3 * v + 2 < mesh.positions.size(); ++v) {
+      const V3 p{mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
+      texels[2 * v] = (dot(p, lx) - ox) / texel;
+      texels[2 * v + 1] = (dot(p, ly) - oy) / texel;
+    }
+    for (std::size_t t = 0; t + 2 < mesh.triangles.size(); t += 3) {
+      const double a[2] = {texels[2 * mesh.triangles[t]], texels[2 * mesh.triangles[t] + 1]};
+      const double b[2] = {texels[2 * mesh.triangles[t + 1]], texels[2 * mesh.triangles[t + 1] + 1]};
+      const double c[2] = {texels[2 * mesh.triangles[t + 2]], texels[2 * mesh.triangles[t + 2] + 1]};
+      cover_triangle(a, b, c, setup.map);
+    }
+  }
+  // The blur on counts, exact: 0 stays 0 wherever no covered texel is within reach.
+  std::vector<int> counts(setup.map.begin(), setup.map.end()), scratch(n * n);
+  int full = 1;
+  for (int pass = 0; pass < kShadowBlurPasses; ++pass) {
+    box_sum(counts, scratch, false);
+    box_sum(counts, scratch, true);
+    full *= (2 * kShadowBlurRadius + 1) * (2 * kShadowBlurRadius + 1);
+  }
+  for (std::size_t i = 0; i < counts.size(); ++i) setup.map[i] = static_cast<float>(counts[i]) / static_cast<float>(full);
+  // Where the map can be non-zero (the meshes' box widened by the blur's reach and a texel for
+  // the bilinear lookup), carried along the light onto the ground.
+  const double wx = 0.5 * (x1 - x0) + (kShadowReach + 1) * texel, wy = 0.5 * (y1 - y0) + (kShadowReach + 1) * texel;
+  const double rise = dot(towards_light, ground.normal);  // cos(tilt) > 0
+  const double corners[4][2] = {{cx - wx, cy - wy}, {cx - wx, cy + wy}, {cx + wx, cy + wy}, {cx + wx, cy - wy}};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const V3 p = corners[k][0] * lx + corners[k][1] * ly;
+    setup.footprint[k] = p + ((ground.height - dot(p, ground.normal)) / rise) * towards_light;
+  }
+  setup.on = true;
+  return setup;
+}
+
 // What the backdrop depends on: image size and background; with a ground also the ground and
 // the camera matrices (without one the backdrop is the cleared buffers, whatever the camera and
 // the near and far planes, which follow the meshes).
 std::vector<float> backdrop_key_for(const Frame& frame, const Mat4f& view, const Mat4f& projection,
-                                    const Vec3f& ground_centre, float ground_half_size) {
+                                    const Ground& ground) {
   std::vector<float> key = {static_cast<float>(frame.width), static_cast<float>(frame.height),
                             frame.background[0], frame.background[1], frame.background[2],
                             frame.ground ? 1.0f : 0.0f};
   if (frame.ground) {
-    key.insert(key.end(), {ground_centre[0], ground_centre[1], ground_centre[2], ground_half_size});
+    // The program that drew it (with or without the shadow's code) is part of the ground.
+    key.insert(key.end(), {frame.shadow ? 1.0f : 0.0f, static_cast<float>(ground.height),
+                           static_cast<float>(ground.half_size)});
+    for (const V3& v : {ground.normal, ground.centre}) {
+      key.insert(key.end(), {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)});
+    }
     key.insert(key.end(), view.begin(), view.end());
     key.insert(key.end(), projection.begin(), projection.end());
   }
@@ -339,19 +562,63 @@ std::vector<float> backdrop_key_for(const Frame& frame, const Mat4f& view, const
 // the image; the whole image if a vertex lies on or behind the camera's plane. A triangle or
 // line with every vertex in front of the camera projects into the convex hull of its vertices'
 // images, and so does whatever of it survives clipping.
-PixelRect drawn_rect(const Frame& frame, const Mat4f& view, const Mat4f& projection,
-                     float widest_line) {
-  double m[16];  // projection · view, column-major
-  for (int c = 0; c < 4; ++c) {
-    for (int r = 0; r < 4; ++r) {
+// projection · view, column-major.
+std::array<double, 16> clip_matrix(const Mat4f& view, const Mat4f& projection) {
+  std::array<double, 16> m{};
+  for (std::size_t c = 0; c < 4; ++c) {
+    for (std::size_t r = 0; r < 4; ++r) {
       double sum = 0;
-      for (int k = 0; k < 4; ++k) {
-        sum += static_cast<double>(projection[static_cast<std::size_t>(4 * k + r)]) *
-               view[static_cast<std::size_t>(4 * c + k)];
+      for (std::size_t k = 0; k < 4; ++k) {
+        sum += static_cast<double>(projection[4 * k + r]) * view[4 * c + k];
       }
       m[4 * c + r] = sum;
     }
   }
+  return m;
+}
+
+// Normalised device coordinates to a pixel rectangle widened by `margin` pixels, within the
+// image.
+PixelRect ndc_rect(const Frame& frame, double lo_x, double hi_x, double lo_y, double hi_y, double margin) {
+  const double w = frame.width, h = frame.height;
+  // Clamped before converting to int.
+  auto pixel = [](double ndc, double size, double shift) {
+    return std::clamp((0.5 * ndc + 0.5) * size + shift, 0.0, size);
+  };
+  PixelRect rect;
+  rect.x0 = static_cast<int>(std::floor(pixel(lo_x, w, -margin)));
+  rect.x1 = static_cast<int>(std::ceil(pixel(hi_x, w, margin)));
+  rect.y0 = static_cast<int>(std::floor(pixel(lo_y, h, -margin)));
+  rect.y1 = static_cast<int>(std::ceil(pixel(hi_y, h, margin)));
+  return rect.empty() ? PixelRect{} : rect;
+}
+
+// The smallest rectangle holding both.
+PixelRect merge(const PixelRect& a, const PixelRect& b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  return {std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1), std::max(a.y1, b.y1)};
+}
+
+// The pixels where the shadow can darken the ground: the bounding rectangle of its footprint's
+// corners (the ground within them is a convex quadrilateral), widened by 2 pixels; the whole
+// image if a corner lies on or behind the camera's plane.
+PixelRect shadow_rect(const Frame& frame, const Mat4f& view, const Mat4f& projection, const ShadowSetup& shadow) {
+  const std::array<double, 16> m = clip_matrix(view, projection);
+  double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
+  for (const V3& p : shadow.footprint) {
+    const double w = m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15];
+    if (!(w > 0)) return whole(frame.width, frame.height);
+    const double sx = (m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12]) / w;
+    const double sy = (m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13]) / w;
+    lo_x = std::min(lo_x, sx), hi_x = std::max(hi_x, sx), lo_y = std::min(lo_y, sy), hi_y = std::max(hi_y, sy);
+  }
+  return ndc_rect(frame, lo_x, hi_x, lo_y, hi_y, 2.0);
+}
+
+PixelRect drawn_rect(const Frame& frame, const Mat4f& view, const Mat4f& projection,
+                     float widest_line) {
+  const std::array<double, 16> m = clip_matrix(view, projection);
   double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x;
   double hi_x = -lo_x, hi_y = -lo_x;
   bool behind = false;
@@ -383,17 +650,7 @@ PixelRect drawn_rect(const Frame& frame, const Mat4f& view, const Mat4f& project
   if (behind) return whole(frame.width, frame.height);
   if (!(lo_x <= hi_x && lo_y <= hi_y)) return {};  // nothing is drawn
   const double margin = 2.0 + (lines ? std::ceil(widest_line) : 0.0);
-  const double w = frame.width, h = frame.height;
-  // Normalised device coordinates to pixels; clamped before converting to int.
-  auto pixel = [](double ndc, double size, double shift) {
-    return std::clamp((0.5 * ndc + 0.5) * size + shift, 0.0, size);
-  };
-  PixelRect rect;
-  rect.x0 = static_cast<int>(std::floor(pixel(lo_x, w, -margin)));
-  rect.x1 = static_cast<int>(std::ceil(pixel(hi_x, w, margin)));
-  rect.y0 = static_cast<int>(std::floor(pixel(lo_y, h, -margin)));
-  rect.y1 = static_cast<int>(std::ceil(pixel(hi_y, h, margin)));
-  return rect.empty() ? PixelRect{} : rect;
+  return ndc_rect(frame, lo_x, hi_x, lo_y, hi_y, margin);
 }
 
 }  // namespace
@@ -413,13 +670,21 @@ struct Renderer::Impl {
   RendererInfo info;
   float line_width_range[2] = {1, 1};
 
+  // A ground program and its uniforms (the shadow's only with SHADOW 1).
+  struct GroundProgram {
+    GLuint program = 0;
+    GLint view = -1, projection = -1, color = -1, background = -1, centre = -1, fade = -1;
+    GLint light = -1, strength = -1, map = -1;
+  };
+
   GLuint surface_program = 0;  // meshes (GROUND 0)
-  GLuint ground_program = 0;   // the ground (GROUND 1)
+  GroundProgram ground_plain;  // the ground (GROUND 1, SHADOW 0)
+  GroundProgram ground_shadowed;  // the ground with the meshes' shadow (GROUND 1, SHADOW 1)
   GLuint line_program = 0;
   GLint surface_view = -1, surface_projection = -1, surface_front = -1, surface_back = -1;
-  GLint ground_view = -1, ground_projection = -1, ground_color = -1, ground_background = -1,
-        ground_centre_location = -1, ground_fade_location = -1;
   GLint line_view = -1, line_projection = -1, line_color = -1;
+  // The shadow map's texture, made on first use.
+  GLuint shadow_texture = 0;
 
   GLuint vao = 0;
   GLuint vertex_buffer = 0;
@@ -473,10 +738,12 @@ struct Renderer::Impl {
   void draw(const Frame& frame, const std::vector<std::vector<float>>& mesh_vertices, Image& image);
   void draw_mesh(const Mesh& mesh, const std::vector<float>& vertices);
   void draw_lines(const Lines& lines);
-  void draw_ground(const Frame& frame, const Mat4f& view, const Mat4f& projection,
-                   const Vec3f& centre, float half_size);
-  void build_backdrop(const Frame& frame, const Mat4f& view, const Mat4f& projection,
-                      const Vec3f& centre, float half_size);
+  GroundProgram link_ground(bool shadow);
+  void draw_ground(const Frame& frame, const Mat4f& view, const Mat4f& projection, const Ground& ground,
+                   const ShadowSetup& shadow, float strength);
+  void upload_shadow_map(const ShadowSetup& shadow);
+  void build_backdrop(const Frame& frame, const Mat4f& view, const Mat4f& projection, const Ground& ground,
+                      const ShadowSetup& shadow);
   void read_back(const PixelRect& rect, std::uint8_t* rgb);
 };
 
@@ -600,19 +867,13 @@ void Renderer::Impl::setup_pipeline(int requested_samples) {
   }
 
   surface_program =
-      link_program(kSurfaceVertexShader, surface_fragment_source(false).c_str(), "surface");
+      link_program(kSurfaceVertexShader, surface_fragment_source(false, false).c_str(), "surface");
   surface_view = uniform(surface_program, "u_view");
   surface_projection = uniform(surface_program, "u_projection");
   surface_front = uniform(surface_program, "u_front_color");
   surface_back = uniform(surface_program, "u_back_color");
-  ground_program =
-      link_program(kSurfaceVertexShader, surface_fragment_source(true).c_str(), "ground");
-  ground_view = uniform(ground_program, "u_view");
-  ground_projection = uniform(ground_program, "u_projection");
-  ground_color = uniform(ground_program, "u_front_color");
-  ground_background = uniform(ground_program, "u_background");
-  ground_centre_location = uniform(ground_program, "u_ground_centre");
-  ground_fade_location = uniform(ground_program, "u_ground_fade");
+  ground_plain = link_ground(false);
+  ground_shadowed = link_ground(true);
   line_program = link_program(kLineVertexShader, kLineFragmentShader, "line");
   line_view = uniform(line_program, "u_view");
   line_projection = uniform(line_program, "u_projection");
@@ -631,6 +892,24 @@ void Renderer::Impl::setup_pipeline(int requested_samples) {
   glEnable(GL_MULTISAMPLE);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   check("setting up the GL pipeline");
+}
+
+Renderer::Impl::GroundProgram Renderer::Impl::link_ground(bool shadow) {
+  GroundProgram g;
+  g.program = link_program(kSurfaceVertexShader, surface_fragment_source(true, shadow).c_str(),
+                           shadow ? "shadowed ground" : "ground");
+  g.view = uniform(g.program, "u_view");
+  g.projection = uniform(g.program, "u_projection");
+  g.color = uniform(g.program, "u_front_color");
+  g.background = uniform(g.program, "u_background");
+  g.centre = uniform(g.program, "u_ground_centre");
+  g.fade = uniform(g.program, "u_ground_fade");
+  if (shadow) {
+    g.light = uniform(g.program, "u_light");
+    g.strength = uniform(g.program, "u_shadow_strength");
+    g.map = uniform(g.program, "u_shadow_map");
+  }
+  return g;
 }
 
 void Renderer::Impl::delete_framebuffers() {
@@ -724,13 +1003,15 @@ void Renderer::Impl::draw_mesh(const Mesh& mesh, const std::vector<float>& verti
 }
 
 void Renderer::Impl::draw_ground(const Frame& frame, const Mat4f& view, const Mat4f& projection,
-                                 const Vec3f& centre, float half_size) {
-  const float y = frame.ground_height;
-  const float x0 = centre[0] - half_size, x1 = centre[0] + half_size;
-  const float z0 = centre[2] - half_size, z1 = centre[2] + half_size;
-  // Counter-clockwise seen from above (+y).
-  const float vertices[] = {x0, y, z0, 0, 1, 0, x0, y, z1, 0, 1, 0,
-                            x1, y, z1, 0, 1, 0, x1, y, z0, 0, 1, 0};
+                                 const Ground& ground, const ShadowSetup& shadow, float strength) {
+  // Counter-clockwise seen from above (the side `normal` points to).
+  const std::array<V3, 4> corners = ground.corners();
+  float vertices[24];
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Vec3f p = to_f(corners[k]), n = to_f(ground.normal);
+    std::copy(p.begin(), p.end(), vertices + 6 * k);
+    std::copy(n.begin(), n.end(), vertices + 6 * k + 3);
+  }
   const unsigned indices[] = {0, 1, 2, 0, 2, 3};
   lap(&RenderPhases::draw);
   glBufferData(GL_ARRAY_BUFFER, sizeof(vertices), vertices, GL_STREAM_DRAW);
@@ -742,13 +1023,23 @@ void Renderer::Impl::draw_ground(const Frame& frame, const Mat4f& view, const Ma
   glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
                         reinterpret_cast<const void*>(3 * sizeof(float)));
   const float grey[3] = {kGroundGrey, kGroundGrey, kGroundGrey};
-  glUseProgram(ground_program);
-  glUniformMatrix4fv(ground_view, 1, GL_FALSE, view.data());
-  glUniformMatrix4fv(ground_projection, 1, GL_FALSE, projection.data());
-  glUniform3fv(ground_background, 1, frame.background.data());
-  glUniform3fv(ground_color, 1, grey);
-  glUniform2f(ground_centre_location, centre[0], centre[2]);
-  glUniform2f(ground_fade_location, 0.25f * half_size, 0.8f * half_size);
+  const GroundProgram& g = frame.shadow ? ground_shadowed : ground_plain;
+  const Vec3f centre = to_f(ground.centre);
+  const float half_size = static_cast<float>(ground.half_size);
+  glUseProgram(g.program);
+  glUniformMatrix4fv(g.view, 1, GL_FALSE, view.data());
+  glUniformMatrix4fv(g.projection, 1, GL_FALSE, projection.data());
+  glUniform3fv(g.background, 1, frame.background.data());
+  glUniform3fv(g.color, 1, grey);
+  glUniform3f(g.centre, centre[0], centre[1], centre[2]);
+  glUniform2f(g.fade, 0.25f * half_size, 0.8f * half_size);
+  if (frame.shadow) {
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, shadow_texture);
+    glUniform1i(g.map, 0);
+    glUniformMatrix4fv(g.light, 1, GL_FALSE, shadow.light.data());
+    glUniform1f(g.strength, shadow.on ? strength : 0.0f);
+  }
   // Pushed further back than the meshes, so that cloth lying on it stays visible.
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(4.0f, 16.0f);
@@ -757,9 +1048,35 @@ void Renderer::Impl::draw_ground(const Frame& frame, const Mat4f& view, const Ma
   lap(&RenderPhases::draw);
 }
 
+// The shadow map's texture: the setup's map, or all 0 (no shadow) without one.
+void Renderer::Impl::upload_shadow_map(const ShadowSetup& shadow) {
+  if (shadow_texture == 0) {
+    glGenTextures(1, &shadow_texture);
+    glBindTexture(GL_TEXTURE_2D, shadow_texture);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+    const float border[4] = {0, 0, 0, 0};  // beyond the map: no shadow
+    glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, border);
+  }
+  glActiveTexture(GL_TEXTURE0);
+  glBindTexture(GL_TEXTURE_2D, shadow_texture);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  if (shadow.on) {
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, kShadowMapSize, kShadowMapSize, 0, GL_RED, GL_FLOAT,
+                 shadow.map.data());
+  } else {
+    const float none = 0;
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, 1, 1, 0, GL_RED, GL_FLOAT, &none);
+  }
+  check("uploading the shadow map");
+  lap(&RenderPhases::shadow);
+}
+
 void Renderer::Impl::build_backdrop(const Frame& frame, const Mat4f& view,
-                                    const Mat4f& projection, const Vec3f& centre,
-                                    float half_size) {
+                                    const Mat4f& projection, const Ground& ground,
+                                    const ShadowSetup& shadow) {
   if (backdrop_fbo == 0) {
     glGenRenderbuffers(1, &backdrop_color);
     glBindRenderbuffer(GL_RENDERBUFFER, backdrop_color);
@@ -785,7 +1102,9 @@ void Renderer::Impl::build_backdrop(const Frame& frame, const Mat4f& view,
   glBindFramebuffer(GL_FRAMEBUFFER, backdrop_fbo);
   glViewport(0, 0, frame.width, frame.height);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-  if (frame.ground) draw_ground(frame, view, projection, centre, half_size);
+  // Without the shadow, which each frame draws over it (with strength 0 the shadowed ground's
+  // colour is exactly the unshadowed one).
+  if (frame.ground) draw_ground(frame, view, projection, ground, shadow, 0.0f);
   check("drawing the backdrop");
   glBindFramebuffer(GL_READ_FRAMEBUFFER, backdrop_fbo);
   glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
@@ -857,6 +1176,8 @@ Image Renderer::Impl::render(const Frame& frame) {
           "camera fov_deg must lie in (0, 180)");
   require(finite3(frame.background) && std::isfinite(frame.ground_height),
           "background and ground height must be finite");
+  require(finite3(frame.up) && (frame.up[0] != 0 || frame.up[1] != 0 || frame.up[2] != 0),
+          "up must be finite and non-zero");
   for (std::size_t i = 0; i < frame.meshes.size(); ++i) {
     const Mesh& mesh = frame.meshes[i];
     const std::string what = "mesh " + std::to_string(i);
@@ -873,27 +1194,19 @@ Image Renderer::Impl::render(const Frame& frame) {
   }
   const Mat4f view = view_matrix(frame.camera);  // throws for a degenerate camera
 
-  // Ground: a square centred below the camera target, sized from the viewing distance so that
-  // it (and its fade) stays fixed while the camera is.
-  double distance = 0;
-  for (std::size_t k = 0; k < 3; ++k) {
-    const double d = static_cast<double>(frame.camera.eye[k]) - frame.camera.target[k];
-    distance += d * d;
-  }
-  distance = std::sqrt(distance);
-  const float ground_half_size = static_cast<float>(12.0 * distance);
-  const Vec3f ground_centre = {frame.camera.target[0], frame.ground_height, frame.camera.target[2]};
+  const Ground ground = ground_of(frame);
+  const double distance = ground.half_size / 12.0;  // eye to target
+  const ShadowSetup shadow = frame.ground && frame.shadow ? shadow_setup(frame, view, ground) : ShadowSetup{};
+  lap(&RenderPhases::shadow);
 
   // Near and far planes hugging the visible geometry.
   DepthRange range;
   for (const Mesh& mesh : frame.meshes) range.add_all(view, mesh.positions);
   for (const Lines& lines : frame.lines) range.add_all(view, lines.positions);
   if (frame.ground) {
-    for (const float sx : {-1.0f, 1.0f}) {
-      for (const float sz : {-1.0f, 1.0f}) {
-        range.add(view, ground_centre[0] + sx * ground_half_size, frame.ground_height,
-                  ground_centre[2] + sz * ground_half_size);
-      }
+    for (const V3& c : ground.corners()) {
+      const Vec3f p = to_f(c);
+      range.add(view, p[0], p[1], p[2]);
     }
   }
   double far_plane = 100.0 * distance;  // nothing in front of the camera: any planes do
@@ -915,7 +1228,7 @@ Image Renderer::Impl::render(const Frame& frame) {
   }
   const PixelRect all = whole(frame.width, frame.height);
   const std::size_t pixels = static_cast<std::size_t>(frame.width) * static_cast<std::size_t>(frame.height);
-  std::vector<float> key = backdrop_key_for(frame, view, projection, ground_centre, ground_half_size);
+  std::vector<float> key = backdrop_key_for(frame, view, projection, ground);
   const bool over_backdrop = key == backdrop_key || key == direct_key;
   const bool new_backdrop = over_backdrop && key != backdrop_key;
   PixelRect drawn = all;
@@ -926,6 +1239,9 @@ Image Renderer::Impl::render(const Frame& frame) {
     }
     drawn = drawn_rect(frame, view, projection, widest_line);
   }
+  // Over the backdrop, the shadow is drawn where it can fall (the ground redrawn there).
+  const PixelRect shadowed = over_backdrop && shadow.on ? shadow_rect(frame, view, projection, shadow) : PixelRect{};
+  drawn = merge(drawn, shadowed);
   read_buffer.resize(4 * pixels);
   if (new_backdrop) backdrop_rgb.resize(3 * pixels);
   Image image;
@@ -946,9 +1262,10 @@ Image Renderer::Impl::render(const Frame& frame) {
     glClearDepth(1.0);
     glDepthMask(GL_TRUE);
     glBindVertexArray(vao);
+    if (frame.ground && frame.shadow) upload_shadow_map(shadow);
     if (over_backdrop) {
       if (new_backdrop) {
-        build_backdrop(frame, view, projection, ground_centre, ground_half_size);
+        build_backdrop(frame, view, projection, ground, shadow);
         backdrop_key = std::move(key);
         std::copy(backdrop_rgb.begin(), backdrop_rgb.end(), image.rgb.begin());
         lap(&RenderPhases::backdrop);
@@ -966,6 +1283,18 @@ Image Renderer::Impl::render(const Frame& frame) {
       ms_dirty = drawn;
       glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
       glViewport(0, 0, frame.width, frame.height);
+      if (!shadowed.empty()) {
+        // The ground again where the shadow can fall, now with it, over the backdrop's ground
+        // (the same program and vertices: the same samples, so no depth test is needed).
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(shadowed.x0, shadowed.y0, shadowed.width(), shadowed.height());
+        glDisable(GL_DEPTH_TEST);
+        glDepthMask(GL_FALSE);
+        draw_ground(frame, view, projection, ground, shadow, kShadowStrength);
+        glDepthMask(GL_TRUE);
+        glEnable(GL_DEPTH_TEST);
+        glDisable(GL_SCISSOR_TEST);
+      }
     } else {
       glBindFramebuffer(GL_FRAMEBUFFER, ms_fbo);
       glViewport(0, 0, frame.width, frame.height);
@@ -985,7 +1314,7 @@ Image Renderer::Impl::render(const Frame& frame) {
     }
     glDisable(GL_POLYGON_OFFSET_FILL);
     if (frame.ground && !over_backdrop) {
-      draw_ground(frame, view, projection, ground_centre, ground_half_size);
+      draw_ground(frame, view, projection, ground, shadow, kShadowStrength);
     }
 
     if (!frame.lines.empty()) {

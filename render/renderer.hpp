@@ -25,6 +25,7 @@ struct RendererInfo {
 // the same with and without timing.
 struct RenderPhases {
   double prepare = 0;   // validation, near/far planes, vertex data (normals when missing), buffers
+  double shadow = 0;    // the shadow map: the meshes' coverage seen from the light, blurred, uploaded
   double backdrop = 0;  // drawing and resolving the backdrop (once per camera, see Renderer)
   double restore = 0;   // the backdrop copied over what the previous frame drew (glFinish)
   double upload = 0;    // glBufferData of vertices and indices
@@ -34,7 +35,7 @@ struct RenderPhases {
   double read = 0;      // glReadPixels of the resolved pixels
   double convert = 0;   // rows flipped to top first, RGBA to RGB
   double total() const {
-    return prepare + backdrop + restore + upload + draw + raster + resolve + read + convert;
+    return prepare + shadow + backdrop + restore + upload + draw + raster + resolve + read + convert;
   }
 };
 

@@ -324,8 +324,8 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   RenderSettings s;
   if (j == nullptr) return s;
   r.check_object(*j, "render",
-                 {"width", "height", "refine", "color", "back_color", "background", "wireframe", "ground", "camera",
-                  "framing", "surface", "texture", "up"});
+                 {"width", "height", "refine", "color", "back_color", "background", "wireframe", "ground", "shadow",
+                  "camera", "framing", "surface", "texture", "up"});
   if (const Json* v = r.find(*j, "width")) s.width = r.integer_at_least(*v, "render.width", 16);
   if (const Json* v = r.find(*j, "height")) s.height = r.integer_at_least(*v, "render.height", 16);
   if (s.width > 8192 || s.height > 8192) r.fail("render", "images larger than 8192 px are not supported");
@@ -345,8 +345,15 @@ RenderSettings read_render(const Reader& r, const Json* j) {
   colour("back_color", s.back_color);
   colour("background", s.background);
   if (const Json* v = r.find(*j, "wireframe")) s.wireframe = r.boolean(*v, "render.wireframe");
-  if (const Json* v = r.find(*j, "texture")) s.texture = r.choice(*v, "render.texture", {"none", "grain", "checker"}, "texture");
-  if (const Json* v = r.find(*j, "ground")) s.ground = r.boolean(*v, "render.ground");
+  if (const Json* v = r.find(*j, "texture")) {
+    s.texture = r.choice(*v, "render.texture", {"none", "grain", "checker"}, "texture");
+    s.texture_given = true;
+  }
+  if (const Json* v = r.find(*j, "ground")) {
+    s.ground = r.boolean(*v, "render.ground");
+    s.ground_given = true;
+  }
+  if (const Json* v = r.find(*j, "shadow")) s.shadow = r.boolean(*v, "render.shadow");
   if (const Json* v = r.find(*j, "up")) {
     const Eigen::Vector3d up = r.vec3(*v, "render.up");
     if (!(up.norm() > 0)) r.fail("render.up", "must not be the zero vector");

@@ -21,6 +21,7 @@ nlohmann::ordered_json render_settings_json(const RenderSettings& s) {
                               {"background", vec3(s.background)},
                               {"wireframe", s.wireframe},
                               {"ground", s.ground},
+                              {"shadow", s.shadow},
                               {"framing", s.framing == Framing::sequence ? "sequence" : "motion"}};
   if (s.texture != "none") j["texture"] = s.texture;  // (only when set: older outputs stay as they were)
   if (s.world_up != Eigen::Vector3d(0, 1, 0)) j["up"] = vec3(s.world_up);  // likewise

@@ -616,6 +616,9 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
   std::optional<SewnPattern> pattern;
   TriMesh mesh = build_mesh(r, mesh_json, file.parent_path(), say, max_vertices, grain,
                             grain.given || scene.problem.material.orthotropic() || draw_grain, pattern);
+  // The default texture: the checker where the mesh has texture coordinates to lay it on.
+  if (!scene.render.texture_given && mesh.uv.size() == mesh.triangles.size() && !mesh.triangles.empty())
+    scene.render.texture = "checker";
   if (scene.render.texture == "checker" && mesh.uv.size() != mesh.triangles.size())
     r.fail("render.texture", "\"checker\" needs texture coordinates on the mesh (a pattern garment, or an OBJ with vt "
                              "on every face)");
@@ -661,10 +664,11 @@ Scene load_scene_json(const Json& root, const Reader& r, const std::filesystem::
       read_boundary(r, r.find(root, "boundary"), scene.problem.mesh, pattern ? &*pattern : nullptr, dynamic, say);
   read_loads(r, r.find(root, "loads"), scene.problem, pattern ? &*pattern : nullptr, dynamic ? &dyn.ramp_time : nullptr, say);
   check_load_magnitudes(r, scene.problem, say);
-  // The pictures' up: opposite to gravity unless the scene says (render.up) — but +y with a ground,
-  // which is always the x–z plane below the cloth (seen from under it, it would hide the cloth).
-  if (!scene.render.up_given && scene.problem.gravity.norm() > 0 && !scene.render.ground)
+  // The pictures' up: opposite to gravity unless the scene says (render.up); the ground, by
+  // default there when gravity is, lies normal to it.
+  if (!scene.render.up_given && scene.problem.gravity.norm() > 0)
     scene.render.world_up = -scene.problem.gravity.normalized();
+  if (!scene.render.ground_given) scene.render.ground = scene.problem.gravity.norm() > 0;
   scene.probes = read_probes(r, r.find(root, "probes"), scene.problem.mesh, say);
   // The boundary and probes were selected on the mesh as placed; the imperfection then changes
   // its rest shape by at most the amplitude.

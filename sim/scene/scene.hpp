@@ -56,12 +56,23 @@ struct RenderSettings {
   // material.grain, warp_deg 0 by default; an OBJ mesh needs texture coordinates for it), or
   // "checker": squares of kCheckerCell on the texture coordinates (a pattern's, in metres), every
   // other one darker, so that the pieces' layout and their stretching read at a glance.
+  // Default: "checker" where the mesh has texture coordinates (a pattern, an OBJ with vt on every
+  // face), "none" otherwise (resolved by the scene loader; `texture_given` when the scene sets it).
   std::string texture = "none";
+  bool texture_given = false;
   static constexpr double kCheckerCell = 0.05;  // [texture units: m for a pattern] side of a checker square
-  bool ground = false;     // a ground plane at the bottom of the framed box (see `framing`)
-  // "render.up": the direction that is up in an automatically framed picture (unit). Default:
-  // opposite to gravity, +y without gravity or with render.ground (the ground is the x–z plane);
-  // a z-up scene is drawn upright. `up_given` when the scene sets it. A scene's own camera has its own up (render.camera.up).
+  // "render.ground": a ground plane normal to `world_up` through the lowest corner of the framed
+  // box (see `framing`). Default: on when the scene has gravity (resolved by the scene loader;
+  // `ground_given` when the scene sets it).
+  bool ground = false;
+  bool ground_given = false;
+  // "render.shadow": the cloth and the obstacles cast a soft shadow on the ground (a light 30°
+  // off up, on the key light's side). No effect without a ground.
+  bool shadow = true;
+  // "render.up": the direction that is up in an automatically framed picture and the ground's
+  // normal (unit). Default: opposite to gravity, +y without gravity; a z-up scene is drawn
+  // upright over a ground in the x–y plane. `up_given` when the scene sets it. A scene's own
+  // camera has its own up (render.camera.up).
   Eigen::Vector3d world_up{0, 1, 0};
   bool up_given = false;
   bool has_camera = false;  // otherwise framed automatically, see `framing`

@@ -44,7 +44,7 @@ TEST(GrainLines, RunAlongTheWarpAndFollowTheDeformation) {
   const Eigen::Vector3f expected = Eigen::Vector3d(2 * std::cos(angle), std::sin(angle), 0).normalized().cast<float>();
   EXPECT_LT(((b - a).normalized() - expected).norm(), 1e-5);
   // The frame carries them as a line overlay.
-  const render::Frame f = drawer.frame(rest, render::Camera{}, 0.0f);
+  const render::Frame f = drawer.frame(rest, render::Camera{}, {0, 0, 0}, {0, 0, 0});
   ASSERT_EQ(f.lines.size(), 1u);
   EXPECT_EQ(f.lines[0].segments.size(), 2 * mesh.triangles.size());
 }
@@ -71,7 +71,7 @@ TEST(CheckerTexture, SplitsTheFineTrianglesBySquare) {
   settings.refine = 1;
   settings.texture = "checker";
   const LimitSurfaceDrawer drawer(d, settings, 64, 48);
-  const render::Frame f = drawer.frame(drawer.snapshot(d.rest()), render::Camera{}, 0.0f);
+  const render::Frame f = drawer.frame(drawer.snapshot(d.rest()), render::Camera{}, {0, 0, 0}, {0, 0, 0});
   ASSERT_EQ(f.meshes.size(), 2u);
   const std::size_t light = f.meshes[0].triangles.size() / 3, dark = f.meshes[1].triangles.size() / 3;
   EXPECT_EQ(light + dark, 4 * mesh.triangles.size());
@@ -82,7 +82,7 @@ TEST(CheckerTexture, SplitsTheFineTrianglesBySquare) {
   bare.uv.clear();
   const LoopShellDiscretization plain(bare, {}, ShellMaterial{}, Quadrature::one_point);
   const LimitSurfaceDrawer no_uv(plain, settings, 64, 48);
-  EXPECT_EQ(no_uv.frame(no_uv.snapshot(plain.rest()), render::Camera{}, 0.0f).meshes.size(), 1u);
+  EXPECT_EQ(no_uv.frame(no_uv.snapshot(plain.rest()), render::Camera{}, {0, 0, 0}, {0, 0, 0}).meshes.size(), 1u);
 }
 
 }  // namespace

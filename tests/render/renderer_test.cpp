@@ -271,7 +271,7 @@ TEST(RendererTest, PhaseTimingReportsPhasesAndKeepsTheImage) {
 
 // A frame of a small animation: the triangle raised by 1.2 and moved along x by `shift`, seen
 // from above the ground, optionally with its edges as a 3-pixel wireframe.
-Frame animation_frame(float shift, bool ground, bool wireframe) {
+Frame animation_frame(float shift, bool ground, bool wireframe, bool shadow = false) {
   Frame frame;
   Mesh mesh = front_triangle();
   for (std::size_t i = 0; i < mesh.positions.size(); i += 3) {
@@ -291,6 +291,7 @@ Frame animation_frame(float shift, bool ground, bool wireframe) {
   frame.width = 160;
   frame.height = 120;
   frame.ground = ground;
+  frame.shadow = shadow;
   return frame;
 }
 
@@ -302,13 +303,15 @@ Image drawn_afresh(const Frame& frame) {
 // One renderer drawing an animation draws its frames over a kept backdrop (background and
 // ground) and resolves only where their meshes and lines can be; each frame must still have
 // the pixels that a renderer of its own gives it: nothing of the previous frame left behind,
-// nothing cut off, also when the camera changes or a vertex lies behind the camera.
+// nothing cut off, also when the camera changes or a vertex lies behind the camera. With a
+// shadow, which moves with the mesh, each frame also redraws the ground where it can fall.
 TEST(RendererTest, AnimationFramesMatchFramesDrawnAfresh) {
-  for (const bool ground : {true, false}) {
+  for (const auto& [ground, shadow] : {std::pair{true, false}, std::pair{true, true}, std::pair{false, false}}) {
     for (const bool wireframe : {false, true}) {
-      SCOPED_TRACE(std::string(ground ? "ground" : "no ground") + (wireframe ? ", wireframe" : ""));
-      const Frame left = animation_frame(-1.6f, ground, wireframe);
-      const Frame right = animation_frame(1.6f, ground, wireframe);
+      SCOPED_TRACE(std::string(ground ? "ground" : "no ground") + (shadow ? ", shadow" : "") +
+                   (wireframe ? ", wireframe" : ""));
+      const Frame left = animation_frame(-1.6f, ground, wireframe, shadow);
+      const Frame right = animation_frame(1.6f, ground, wireframe, shadow);
       Frame turned = left;  // another camera
       turned.camera.eye = {1.5f, 2.0f, 5.5f};
       Frame behind = left;  // a triangle reaching behind the camera: drawn and resolved whole
@@ -336,6 +339,52 @@ TEST(RendererTest, AnimationFramesMatchFramesDrawnAfresh) {
       }
     }
   }
+}
+
+// The shadow darkens the ground where the mesh hides the light (30° off up, on the key light's
+// side: upper left of the view, so it falls to the right and away), and nothing else: not the
+// mesh, not the ground far from it. A ground normal to z gives the same picture as one normal to
+// y when everything is turned with it.
+TEST(RendererTest, ShadowDarkensOnlyTheGroundBelowTheMesh) {
+  Frame plain = animation_frame(0, true, false, false);
+  Frame shadowed = plain;
+  shadowed.shadow = true;
+  const Image a = shared_renderer().render(plain);
+  const Image b = shared_renderer().render(shadowed);
+  int darker = 0, lighter = 0, right_of_centre = 0;
+  for (int y = 0; y < 120; ++y) {
+    for (int x = 0; x < 160; ++x) {
+      const auto p = pixel(a, x, y), q = pixel(b, x, y);
+      if (q[1] + 20 < p[1]) {
+        ++darker;
+        right_of_centre += x > 80;
+        EXPECT_EQ(p[0], p[1]) << "only the (grey) ground darkens, at " << x << ", " << y;
+      }
+      lighter += q[0] > p[0] || q[1] > p[1] || q[2] > p[2];
+    }
+  }
+  EXPECT_GT(darker, 100);
+  EXPECT_EQ(lighter, 0);
+  EXPECT_GT(right_of_centre, darker / 2);
+  // The mesh's own centre is untouched.
+  const PixelPosition centre = project_to_pixel(plain.camera, 160, 120, {0, 1.2f + 0.2f, 0});
+  EXPECT_EQ(pixel(a, static_cast<int>(centre.x), static_cast<int>(centre.y)),
+            pixel(b, static_cast<int>(centre.x), static_cast<int>(centre.y)));
+  // Turned by +90° about x (y to z): the same picture, but for the shadow map's texel grid.
+  auto turn = [](Vec3f v) { return Vec3f{v[0], -v[2], v[1]}; };
+  Frame z_up = shadowed;
+  z_up.up = {0, 0, 1};
+  z_up.camera.eye = turn(z_up.camera.eye);
+  z_up.camera.target = turn(z_up.camera.target);
+  z_up.camera.up = turn(z_up.camera.up);
+  for (std::size_t i = 0; i < z_up.meshes[0].positions.size(); i += 3) {
+    const Vec3f v = turn({z_up.meshes[0].positions[i], z_up.meshes[0].positions[i + 1], z_up.meshes[0].positions[i + 2]});
+    std::copy(v.begin(), v.end(), z_up.meshes[0].positions.begin() + static_cast<std::ptrdiff_t>(i));
+  }
+  const Image c = shared_renderer().render(z_up);
+  int differ = 0;
+  for (std::size_t i = 0; i < b.rgb.size(); ++i) differ += std::abs(int(b.rgb[i]) - int(c.rgb[i])) > 16;
+  EXPECT_LT(differ, 100);
 }
 
 // A renderer handed from thread to thread (release_context on the one that is done) draws the
@@ -381,8 +430,8 @@ TEST(FrameBoundsTest, BoxCornersProjectInsideImage) {
     int width, height;
     Vec3f direction;
   };
-  for (const Case& c : {Case{64, 48, {-1, -0.5f, -1}}, Case{96, 32, {0, 0, -1}},
-                        Case{32, 80, {1, -1, 0.2f}}, Case{64, 48, {0, -1, 0}}}) {
+  for (const Case& c : {Case{128, 96, {-1, -0.5f, -1}}, Case{192, 64, {0, 0, -1}},
+                        Case{64, 160, {1, -1, 0.2f}}, Case{128, 96, {0, -1, 0}}}) {  // margins of 2 px and more
     const float aspect = static_cast<float>(c.width) / static_cast<float>(c.height);
     const Camera camera = frame_bounds(lo, hi, 35, c.direction, {0, 1, 0}, aspect);
     float min_x = 1e9f, max_x = -1e9f, min_y = 1e9f, max_y = -1e9f;
@@ -400,12 +449,15 @@ TEST(FrameBoundsTest, BoxCornersProjectInsideImage) {
       min_y = std::min(min_y, p.y);
       max_y = std::max(max_y, p.y);
     }
-    // Not absurdly small: the box spans a fair part of the image (the bounding sphere of this
-    // elongated box fits, so a thin side may look small).
-    EXPECT_GT(std::max((max_x - min_x) / static_cast<float>(c.width),
-                       (max_y - min_y) / static_cast<float>(c.height)),
-              0.25f)
-        << c.width << " x " << c.height;
+    // Tight: in the direction that binds, the box's corners span the image but for the 5 %
+    // margin (1 / 1.05 of it), centred.
+    const float fx = (max_x - min_x) / static_cast<float>(c.width), fy = (max_y - min_y) / static_cast<float>(c.height);
+    EXPECT_NEAR(std::max(fx, fy), 1 / 1.05f, 2e-3f) << c.width << " x " << c.height;
+    if (fx > fy) {
+      EXPECT_NEAR(min_x + max_x, static_cast<float>(c.width), 0.05f);
+    } else {
+      EXPECT_NEAR(min_y + max_y, static_cast<float>(c.height), 0.05f);
+    }
 
     // The renderer agrees: the box is drawn, and the image border is untouched background.
     Frame frame;

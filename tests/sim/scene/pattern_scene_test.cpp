@@ -43,6 +43,16 @@ std::string dynamic(const std::string& extra) {
     "time": {"dt": 0.005, "end": 0.01})" + extra + "}";
 }
 
+// render.texture defaults to the checker where the mesh has texture coordinates (a pattern's),
+// and a scene's own choice wins.
+TEST_F(PatternScene, ThePicturesShowTheCheckerByDefault) {
+  EXPECT_EQ(load(dynamic("")).render.texture, "checker");
+  EXPECT_EQ(load(dynamic(R"(, "render": {"texture": "none"})")).render.texture, "none");
+  EXPECT_EQ(load(dynamic(R"(, "render": {"texture": "grain"})")).render.texture, "grain");
+  // A grid has no texture coordinates: plain colour.
+  EXPECT_EQ(load(R"({"mesh": {"primitive": "grid", "size": [0.2, 0.1], "divisions": [4, 2]}})").render.texture, "none");
+}
+
 TEST_F(PatternScene, TheContractsSkirtIsSewnAndRestsFlat) {
   const Scene s = load(dynamic(R"(, "settle": {"time": 0.5})"));
   // The same mesh as the builder makes from the same pieces and seams.

@@ -22,6 +22,7 @@ void expect_same(const RenderSettings& a, const RenderSettings& b) {
   EXPECT_EQ(a.wireframe, b.wireframe);
   EXPECT_EQ(a.texture, b.texture);
   EXPECT_EQ(a.ground, b.ground);
+  EXPECT_EQ(a.shadow, b.shadow);
   EXPECT_EQ(a.has_camera, b.has_camera);
   EXPECT_EQ(a.eye, b.eye);
   EXPECT_EQ(a.target, b.target);
@@ -50,7 +51,7 @@ TEST(RenderSettingsJson, DefaultsRoundTrip) {
   EXPECT_EQ(render_settings_json(defaults).dump(),
             R"({"width":960,"height":720,"refine":2,"surface":"method","color":[0.8,0.1,0.1],)"
             R"("back_color":[0.5,0.1,0.1],"background":[1.0,1.0,1.0],"wireframe":false,"ground":false,)"
-            R"("framing":"motion"})");
+            R"("shadow":true,"framing":"motion"})");
 }
 
 TEST(RenderSettingsJson, EveryKeyChangedRoundTrips) {
@@ -65,6 +66,7 @@ TEST(RenderSettingsJson, EveryKeyChangedRoundTrips) {
   s.wireframe = true;
   s.texture = "grain";
   s.ground = true;
+  s.shadow = false;
   s.has_camera = true;
   s.eye = {0.3, -0.3, 0.6};
   s.target = {0, 0, -0.05};

@@ -583,6 +583,24 @@ TEST_F(SceneLoader, RenderFraming) {
                        expected("render.framing: expected a string")));
 }
 
+// render.ground is on by default where gravity is, and lies normal to render.up (opposite to
+// gravity); render.shadow is on by default.
+TEST_F(SceneLoader, RenderGroundAndShadowDefaults) {
+  const std::string dynamic = std::string(R"({"analysis": "dynamic", "time": {"dt": 0.01, "end": 0.02}, )") + kGrid4;
+  const Scene without_gravity = load(dynamic + "}");
+  EXPECT_FALSE(without_gravity.render.ground);
+  EXPECT_TRUE(without_gravity.render.shadow);
+  const Scene z_up = load(dynamic + R"(, "loads": {"gravity": [0, 0, -9.81]}})");
+  EXPECT_TRUE(z_up.render.ground);
+  EXPECT_EQ(z_up.render.world_up, Eigen::Vector3d(0, 0, 1));  // the ground is the x-y plane
+  EXPECT_FALSE(load(dynamic + R"(, "loads": {"gravity": [0, 0, -9.81]}, "render": {"ground": false}})").render.ground);
+  EXPECT_TRUE(load(dynamic + R"(, "render": {"ground": true}})").render.ground);
+  EXPECT_FALSE(load(dynamic + R"(, "render": {"shadow": false}})").render.shadow);
+  EXPECT_EQ(error(dynamic + R"(, "render": {"shadow": 1}})"), expected("render.shadow: expected true or false (got 1)"));
+  // A static scene without gravity: no ground.
+  EXPECT_FALSE(load(std::string("{") + kGrid4 + "}").render.ground);
+}
+
 TEST_F(SceneLoader, MotionErrors) {
   auto motion = [&](const std::string& list, const std::string& fix = R"(["x", "y", "z"])") {
     return error(std::string(R"({"analysis": "dynamic", )") + kGrid4 +
