@@ -221,6 +221,10 @@ class SleeveScene {
     j["mesh"]["rings"] = m.rings;
     j["time"]["dt"] = dt;
     j["time"]["end"] = all_sample_times(case_).back();
+    // The perfect sleeve: the study's windows lie around its first buckling (docs/convergence.md),
+    // which a shipped scene's seeded imperfection moves (the compressed sleeve then buckles at
+    // once), so the imperfection is left out.
+    j.erase("imperfection");
     // The mesh and time-step series solve to 1e-8 (kSeriesTolerance), whatever the scene's default:
     // their differences go down to 1e-4 (neighbouring settings), which the solver error must not touch.
     j["solver"]["tolerance"] = tolerance ? *tolerance : kSeriesTolerance;

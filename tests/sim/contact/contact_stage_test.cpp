@@ -1012,12 +1012,15 @@ TEST(ContactNewton, CrushedSleeveConvergesWithoutTheFailSafe) {
   // held them at half their rest distance) are pressed into each other. Newton then converges in
   // a few solves per step, and the fail-safe has nothing to do. Measured: at most 4 solves in a
   // step, 830 in 700 steps, 0 impulses; without the near pairs' barrier 996 solves, 15 steps above
-  // 4 and one at the cap of 12 (the full-size crush: 12 in every step from 0.8 s on).
+  // 4 and one at the cap of 12 (the full-size crush: 12 in every step from 0.8 s on). These are
+  // the perfect sleeve's numbers; the shipped scene's 0.1 mm imperfection (2026-11-29) folds it
+  // otherwise and is left out here. With it: 1388 solves in 700 steps, the cap of 12 reached at
+  // step 550, still 0 impulses, 0 unresolved and no crossing.
   const auto t0 = std::chrono::steady_clock::now();
   const std::filesystem::path file = std::filesystem::path(CLOTHSIM_SOURCE_DIR) / "scenes" / "sleeve_compress.json";
   Scene scene = load_scene(file, nullptr,
                            {"boundary[1].motion[0].displacement=[0,-0.12,0]", "boundary[1].motion[0].end=0.6", "mesh.segments=18",
-                            "mesh.rings=13", "time.end=0.7"});
+                            "mesh.rings=13", "time.end=0.7", "imperfection=null"});
   const Problem& p = scene.problem;
   Simulator sim(p);
   long long solves = 0, impulses = 0, unresolved = 0;
