@@ -45,8 +45,8 @@ struct Frame {
   Camera camera;
   Vec3f background{1, 1, 1};
   // A large matte light grey plane {x : x · up = ground_height}, centred below the camera
-  // target, sized from the eye-target distance and fading into the background towards its edge
-  // (so it is the same in every frame of an animation with a fixed camera). `up` is the ground's
+  // target, sized from the eye-target distance d and fading into the background from 1.5 d to
+  // 4 d around its centre (so it is the same in every frame of an animation with a fixed camera). `up` is the ground's
   // normal, the side it is seen from; it need not be unit length.
   bool ground = false;
   float ground_height = 0;

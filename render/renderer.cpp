@@ -115,8 +115,13 @@ void main() {
     vec4 s = u_light * vec4(v_world_position, 1.0);
     color *= 1.0 - u_shadow_strength * texture(u_shadow_map, s.xy).r;
 #endif
+    // Fading into the background far from the centre, and where the view grazes the ground
+    // (below about 12° of elevation, gone at 2°), so that a low camera sees a floor that fades
+    // out softly rather than a horizon line.
     float d = distance(v_world_position, u_ground_centre);
-    color = mix(color, u_background, smoothstep(u_ground_fade.x, u_ground_fade.y, d));
+    float elevation = abs(dot(normalize(v_view_position), n));  // sine of the view's angle to the ground
+    float fade = max(smoothstep(u_ground_fade.x, u_ground_fade.y, d), 1.0 - smoothstep(0.04, 0.2, elevation));
+    color = mix(color, u_background, fade);
   }
   o_color = vec4(clamp(color, 0.0, 1.0), 1.0);
 }
@@ -1032,7 +1037,9 @@ void Renderer::Impl::draw_ground(const Frame& frame, const Mat4f& view, const Ma
   glUniform3fv(g.background, 1, frame.background.data());
   glUniform3fv(g.color, 1, grey);
   glUniform3f(g.centre, centre[0], centre[1], centre[2]);
-  glUniform2f(g.fade, 0.25f * half_size, 0.8f * half_size);
+  // Fading out from 1.5 to 4 eye-target distances around the centre: a floor under the framed
+  // things rather than a plain to the horizon (a low camera sees a soft edge, not a horizon line).
+  glUniform2f(g.fade, 0.125f * half_size, (1.0f / 3.0f) * half_size);
   if (frame.shadow) {
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, shadow_texture);
