@@ -1,6 +1,8 @@
 // Camera geometry: look-at and perspective matrices, point projection, box framing.
 #include "render/camera_math.hpp"
 
+#include "render/vec3d.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -11,22 +13,7 @@
 namespace clothsim::render {
 namespace {
 
-struct Vec3d {
-  double x = 0, y = 0, z = 0;
-};
-
-Vec3d to_d(const Vec3f& v) { return {v[0], v[1], v[2]}; }
-Vec3d operator-(const Vec3d& a, const Vec3d& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Vec3d operator+(const Vec3d& a, const Vec3d& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Vec3d operator*(double s, const Vec3d& a) { return {s * a.x, s * a.y, s * a.z}; }
-double dot(const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-double norm(const Vec3d& a) { return std::sqrt(dot(a, a)); }
-bool finite(const Vec3d& a) {
-  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
-}
+using namespace detail;
 
 // Unit right, up and backward (−forward) axes of a camera looking along `forward`.
 struct Basis {

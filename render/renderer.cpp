@@ -2,6 +2,8 @@
 // per-frame upload and drawing of meshes, ground and lines, and read-back.
 #include "render/renderer.hpp"
 
+#include "render/vec3d.hpp"
+
 #include <GL/osmesa.h>  // includes GL/gl.h and GL/glext.h; GL_GLEXT_PROTOTYPES is set by CMake
 
 #include <algorithm>
@@ -350,27 +352,13 @@ struct PixelRect {
 
 PixelRect whole(int width, int height) { return {0, 0, width, height}; }
 
-struct V3 {
-  double x = 0, y = 0, z = 0;
-};
-V3 operator+(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 operator*(double s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
-double dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 cross(const V3& a, const V3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-V3 unit(const V3& a) { return (1.0 / std::sqrt(dot(a, a))) * a; }
-V3 to_v3(const Vec3f& v) { return {v[0], v[1], v[2]}; }
-Vec3f to_f(const V3& v) {
-  return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
-}
+using namespace detail;
 
 // A unit vector perpendicular to the unit vector n: n × (the axis least aligned with n).
-V3 perpendicular(const V3& n) {
-  const V3 axes[3] = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
-  const V3* best = &axes[0];
-  for (const V3& a : axes) {
+Vec3d perpendicular(const Vec3d& n) {
+  const Vec3d axes[3] = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}};
+  const Vec3d* best = &axes[0];
+  for (const Vec3d& a : axes) {
     if (std::abs(dot(a, n)) < std::abs(dot(*best, n)) - 1e-12) best = &a;
   }
   return unit(cross(n, *best));
@@ -380,25 +368,25 @@ V3 perpendicular(const V3& n) {
 // `half_size` centred at `centre` below the camera target, spanned by `e1` and `e2` (e1 × e2 =
 // −normal, so that its corners centre ∓ e1 ∓ e2 run counter-clockwise seen from above).
 struct Ground {
-  V3 normal{0, 1, 0};
+  Vec3d normal{0, 1, 0};
   double height = 0;
-  V3 centre;
+  Vec3d centre;
   double half_size = 0;
-  V3 e1{1, 0, 0}, e2{0, 0, 1};
-  std::array<V3, 4> corners() const {
-    const V3 a = half_size * e1, b = half_size * e2;
+  Vec3d e1{1, 0, 0}, e2{0, 0, 1};
+  std::array<Vec3d, 4> corners() const {
+    const Vec3d a = half_size * e1, b = half_size * e2;
     return {centre - a - b, centre - a + b, centre + a + b, centre + a - b};
   }
 };
 
 Ground ground_of(const Frame& frame) {
   Ground g;
-  g.normal = unit(to_v3(frame.up));
+  g.normal = unit(to_d(frame.up));
   g.height = frame.ground_height;
-  const V3 target = to_v3(frame.camera.target);
+  const Vec3d target = to_d(frame.camera.target);
   g.centre = target - (dot(target, g.normal) - g.height) * g.normal;
   // Sized from the viewing distance, so that it (and its fade) stays fixed while the camera does.
-  g.half_size = 12.0 * std::sqrt(dot(to_v3(frame.camera.eye) - target, to_v3(frame.camera.eye) - target));
+  g.half_size = 12.0 * std::sqrt(dot(to_d(frame.camera.eye) - target, to_d(frame.camera.eye) - target));
   g.e1 = perpendicular(g.normal);
   g.e2 = cross(g.e1, g.normal);
   return g;
@@ -413,7 +401,7 @@ struct ShadowSetup {
   bool on = false;
   Mat4f light{};                // world to map coordinates, [0, 1]^2 across the map
   std::vector<float> map;       // kShadowMapSize² occlusion in [0, 1], row by row
-  std::array<V3, 4> footprint;  // ground points around every place the map is not 0
+  std::array<Vec3d, 4> footprint;  // ground points around every place the map is not 0
 };
 
 // Marks the texels whose centre lies in the triangle (a, b, c) given in texel units (most of a
@@ -469,19 +457,19 @@ ShadowSetup shadow_setup(const Frame& frame, const Mat4f& view, const Ground& gr
   ShadowSetup setup;
   // The key light's direction in the world (it is fixed in camera space, see the shader), its
   // part along the ground, and the light kShadowTiltDeg off the normal on that side.
-  const V3 key_view = unit({-0.45, 0.6, 0.75});
-  const V3 right{view[0], view[4], view[8]}, up{view[1], view[5], view[9]}, back{view[2], view[6], view[10]};
-  const V3 key = key_view.x * right + key_view.y * up + key_view.z * back;
-  V3 side = key - dot(key, ground.normal) * ground.normal;
+  const Vec3d key_view = unit({-0.45, 0.6, 0.75});
+  const Vec3d right{view[0], view[4], view[8]}, up{view[1], view[5], view[9]}, back{view[2], view[6], view[10]};
+  const Vec3d key = key_view.x * right + key_view.y * up + key_view.z * back;
+  Vec3d side = key - dot(key, ground.normal) * ground.normal;
   side = dot(side, side) > 1e-12 ? unit(side) : ground.e1;
   const double tilt = kShadowTiltDeg * std::numbers::pi / 180.0;
-  const V3 towards_light = std::cos(tilt) * ground.normal + std::sin(tilt) * side;
-  const V3 lx = perpendicular(towards_light), ly = cross(towards_light, lx);
+  const Vec3d towards_light = std::cos(tilt) * ground.normal + std::sin(tilt) * side;
+  const Vec3d lx = perpendicular(towards_light), ly = cross(towards_light, lx);
   double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
   for (const Mesh& mesh : frame.meshes) {
     if (mesh.triangles.empty()) continue;
     for (std::size_t i = 0; i + 2 < mesh.positions.size(); i += 3) {
-      const V3 p{mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]};
+      const Vec3d p{mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]};
       const double x = dot(p, lx), y = dot(p, ly);
       x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
     }
@@ -508,7 +496,7 @@ ShadowSetup shadow_setup(const Frame& frame, const Mat4f& view, const Ground& gr
     if (mesh.triangles.empty()) continue;
     texels.resize(2 * (mesh.positions.size() / 3));
     for (std::size_t v = 0; 3 * v + 2 < mesh.positions.size(); ++v) {
-      const V3 p{mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
+      const Vec3d p{mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]};
       texels[2 * v] = (dot(p, lx) - ox) / texel;
       texels[2 * v + 1] = (dot(p, ly) - oy) / texel;
     }
@@ -534,7 +522,7 @@ ShadowSetup shadow_setup(const Frame& frame, const Mat4f& view, const Ground& gr
   const double rise = dot(towards_light, ground.normal);  // cos(tilt) > 0
   const double corners[4][2] = {{cx - wx, cy - wy}, {cx - wx, cy + wy}, {cx + wx, cy + wy}, {cx + wx, cy - wy}};
   for (std::size_t k = 0; k < 4; ++k) {
-    const V3 p = corners[k][0] * lx + corners[k][1] * ly;
+    const Vec3d p = corners[k][0] * lx + corners[k][1] * ly;
     setup.footprint[k] = p + ((ground.height - dot(p, ground.normal)) / rise) * towards_light;
   }
   setup.on = true;
@@ -553,7 +541,7 @@ std::vector<float> backdrop_key_for(const Frame& frame, const Mat4f& view, const
     // The program that drew it (with or without the shadow's code) is part of the ground.
     key.insert(key.end(), {frame.shadow ? 1.0f : 0.0f, static_cast<float>(ground.height),
                            static_cast<float>(ground.half_size)});
-    for (const V3& v : {ground.normal, ground.centre}) {
+    for (const Vec3d& v : {ground.normal, ground.centre}) {
       key.insert(key.end(), {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)});
     }
     key.insert(key.end(), view.begin(), view.end());
@@ -611,7 +599,7 @@ PixelRect merge(const PixelRect& a, const PixelRect& b) {
 PixelRect shadow_rect(const Frame& frame, const Mat4f& view, const Mat4f& projection, const ShadowSetup& shadow) {
   const std::array<double, 16> m = clip_matrix(view, projection);
   double lo_x = std::numeric_limits<double>::infinity(), lo_y = lo_x, hi_x = -lo_x, hi_y = -lo_x;
-  for (const V3& p : shadow.footprint) {
+  for (const Vec3d& p : shadow.footprint) {
     const double w = m[3] * p.x + m[7] * p.y + m[11] * p.z + m[15];
     if (!(w > 0)) return whole(frame.width, frame.height);
     const double sx = (m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12]) / w;
@@ -1010,7 +998,7 @@ void Renderer::Impl::draw_mesh(const Mesh& mesh, const std::vector<float>& verti
 void Renderer::Impl::draw_ground(const Frame& frame, const Mat4f& view, const Mat4f& projection,
                                  const Ground& ground, const ShadowSetup& shadow, float strength) {
   // Counter-clockwise seen from above (the side `normal` points to).
-  const std::array<V3, 4> corners = ground.corners();
+  const std::array<Vec3d, 4> corners = ground.corners();
   float vertices[24];
   for (std::size_t k = 0; k < 4; ++k) {
     const Vec3f p = to_f(corners[k]), n = to_f(ground.normal);
@@ -1211,7 +1199,7 @@ Image Renderer::Impl::render(const Frame& frame) {
   for (const Mesh& mesh : frame.meshes) range.add_all(view, mesh.positions);
   for (const Lines& lines : frame.lines) range.add_all(view, lines.positions);
   if (frame.ground) {
-    for (const V3& c : ground.corners()) {
+    for (const Vec3d& c : ground.corners()) {
       const Vec3f p = to_f(c);
       range.add(view, p[0], p[1], p[2]);
     }
