@@ -44,15 +44,17 @@ struct Frame {
   std::vector<Lines> lines;
   Camera camera;
   Vec3f background{1, 1, 1};
-  // A large matte light grey plane {x : x · up = ground_height}, centred below the camera
+  // A large matte light grey plane {x : x · û = ground_height}, û = up / |up| (the ground's
+  // normal, the side it is seen from; `up` need not be unit length), centred below the camera
   // target, sized from the eye-target distance d and fading into the background from 1.5 d to
-  // 4 d around its centre (so it is the same in every frame of an animation with a fixed camera). `up` is the ground's
-  // normal, the side it is seen from; it need not be unit length.
+  // 4 d around its centre and where the view grazes it (so it is the same in every frame of an
+  // animation with a fixed camera).
   bool ground = false;
   float ground_height = 0;
   Vec3f up{0, 1, 0};
-  // With a ground: the meshes cast a soft shadow on it (a shadow map of a directional light 30°
-  // off `up`, on the key light's side, filtered over about 1.5 % of the meshes' extent).
+  // With a ground: the meshes cast a soft shadow on it (their coverage seen from a directional
+  // light 30° off `up` on the key light's side, blurred over about 1 % of their extent; the
+  // ground is taken to lie below them).
   bool shadow = false;
   int width = 960;
   int height = 720;
