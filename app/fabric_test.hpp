@@ -15,10 +15,11 @@ struct FabricTestOptions {
   std::string target;                             // a preset name or a scene file (.json)
   std::vector<std::string> tests = {"cantilever", "bias", "cusick"};
   std::filesystem::path out_root = "out";
-  std::vector<int> rings = {16, 24, 32};          // Cusick meshes, coarse to fine
+  std::vector<int> rings;                         // Cusick meshes, coarse to fine (empty: default_cusick_rings)
   double cusick_end = 3.0;                        // [s]
   double cusick_ramp = 0.0;                       // Cusick: gravity ramped in over this time [s] (0: at once)
   double imperfection = 0.0;                      // Cusick: seeded imperfection amplitude [m] (0: none)
+  bool loose = false;                             // Cusick: the specimen lies loose on the support (no upper disc)
   bool quick = false;                             // coarse and short (seconds; for tests)
   bool render = true;
 };

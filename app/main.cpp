@@ -368,7 +368,9 @@ int fabric_test_command(int argc, char** argv) {
   app.add_option("--out", out, "Output root; the report goes to DIR/fabric_test_<name>/")
       ->type_name("DIR")
       ->capture_default_str();
-  app.add_option("--rings", rings, "Cusick meshes as disc ring counts, coarse to fine (default 16,24,32)")
+  app.add_option("--rings", rings,
+                 "Cusick meshes, coarse to fine: rings across the hanging annulus (clamped) or of the disc (--loose) "
+                 "(default 12,16,24 clamped, 16,24,32 loose)")
       ->type_name("N,N,...");
   app.add_option("--end", options.cusick_end, "Cusick: simulated time [s]")->type_name("T")->capture_default_str();
   app.add_option("--ramp", options.cusick_ramp,
@@ -380,6 +382,8 @@ int fabric_test_command(int argc, char** argv) {
                  "Cusick: a seeded imperfection of the specimen, largest normal offset A [m] (scene key imperfection)")
       ->type_name("A")
       ->capture_default_str();
+  app.add_flag("--loose", options.loose,
+               "Cusick: the specimen lies loose on the support disc (no upper disc clamping it, unlike the standard)");
   app.add_flag("--quick", options.quick, "Coarse meshes and short runs (seconds; the numbers are not the test's)");
   bool no_render = false;
   app.add_flag("--no-render", no_render, "Write no pictures");
@@ -417,6 +421,10 @@ int fabric_test_command(int argc, char** argv) {
         return 1;
       }
       options.rings.push_back(n);
+    }
+    if (options.rings.empty()) {
+      std::cerr << "clothsim: error: --rings: give at least one mesh\n";
+      return 1;
     }
   }
   options.out_root = out;

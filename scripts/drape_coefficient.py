@@ -8,7 +8,8 @@ Reads an OBJ frame of the cloth (v and f lines; best the refined limit surface w
 with "output": {"obj": true, "obj_level": 2}), projects it vertically onto the x-z plane
 (its shadow from above, gravity along -y) and prints
 
-  A_shadow   area of the union of the projected triangles, by rasterising them on a
+  A_shadow   area of the union of the projected triangles and the support disc (radius
+             R0 about the y axis), by rasterising them on a
              square grid of cell H (default 0.5 mm): a cell counts if its centre lies
              in some projected triangle. The error is of the order of the cells cut by
              the outline; the script prints the bound (boundary cells) x H^2 / 2 and
@@ -78,13 +79,21 @@ def rasterise(pts, tris, h, x0, z0, nx, nz):
     return grid
 
 
-def shadow(pts, tris, h):
-    xs = [p[0] for p in pts]
-    zs = [p[1] for p in pts]
+def shadow(pts, tris, h, r0):
+    """The projected triangles and the support disc (radius r0 about the y axis: opaque and under
+    the specimen, so always in the shadow; a clamped specimen's mesh may leave its middle out)."""
+    xs = [p[0] for p in pts] + [-r0, r0]
+    zs = [p[1] for p in pts] + [-r0, r0]
     x0, z0 = min(xs) - 2 * h, min(zs) - 2 * h
     nx = int(math.ceil((max(xs) - x0) / h)) + 2
     nz = int(math.ceil((max(zs) - z0) / h)) + 2
     grid = rasterise(pts, tris, h, x0, z0, nx, nz)
+    for j in range(nz):
+        pz = z0 + (j + 0.5) * h
+        for i in range(nx):
+            px = x0 + (i + 0.5) * h
+            if px * px + pz * pz <= r0 * r0:
+                grid[j * nx + i] = 1
     return grid, x0, z0, nx, nz
 
 
@@ -182,7 +191,7 @@ def main(argv=None):
         return 1
     pts = [(v[0], v[2]) for v in verts]
     h = a.cell
-    grid, x0, z0, nx, nz = shadow(pts, tris, h)
+    grid, x0, z0, nx, nz = shadow(pts, tris, h, a.support_radius)
     area = sum(grid) * h * h
     nb = boundary_cells(grid, nx, nz)
     err = 0.5 * nb * h * h
@@ -198,7 +207,7 @@ def main(argv=None):
     print("A_shadow        %.6f m^2  (+- %.6f m^2 resolution bound: %d boundary cells x H^2/2)"
           % (area, err, nb))
     if not a.no_check:
-        g2, _, _, _, _ = shadow(pts, tris, 2 * h)
+        g2, _, _, _, _ = shadow(pts, tris, 2 * h, a.support_radius)
         a2 = sum(g2) * 4 * h * h
         print("A_shadow (2H)   %.6f m^2  (DC %.4f)" % (a2, (a2 - a_sup) / (a_spec - a_sup)))
     print("A_support       %.6f m^2, A_specimen %.6f m^2" % (a_sup, a_spec))

@@ -138,15 +138,27 @@ std::vector<int> select_in_box(const Reader& r, const Json& box, const std::stri
   return vertices;
 }
 
-// A boundary's or a load's "select": one of "box" (select_in_box) or, on a pattern garment,
-// "piece_edge" (select_piece_edge) and "piece" (select_piece_region).
+// {"ball": {"center": [x, y, z], "radius": r}} at `path`: the control vertices in the closed ball
+// (at least one).
+std::vector<int> select_in_ball(const Reader& r, const Json& ball, const std::string& path, const TriMesh& mesh) {
+  r.check_object(ball, path, {"center", "radius"});
+  const Eigen::Vector3d center = r.vec3(r.require(ball, path, "center"), join_key(path, "center"));
+  const double radius = r.positive(r.require(ball, path, "radius"), join_key(path, "radius"), "[m]");
+  std::vector<int> vertices = select_ball(mesh.vertices, center, radius);
+  if (vertices.empty())
+    r.fail(path, "selects no vertex of the mesh (mesh bounding box: " + bounding_box(mesh.vertices) + ")");
+  return vertices;
+}
+
+// A boundary's or a load's "select": one of "box" (select_in_box), "ball" (select_in_ball) or, on
+// a pattern garment, "piece_edge" (select_piece_edge) and "piece" (select_piece_region).
 std::vector<int> read_selection(const Reader& r, const Json& item, const std::string& path, const TriMesh& mesh,
                                 const SewnPattern* pattern) {
   const std::string select_path = join_key(path, "select");
   const Json& select = r.require(item, path, "select");
-  r.check_object(select, select_path, {"box", "piece_edge", "piece"});
-  if (select.contains("box") + select.contains("piece_edge") + select.contains("piece") != 1)
-    r.fail(select_path, "give one of \"box\", \"piece_edge\" and \"piece\"");
+  r.check_object(select, select_path, {"box", "ball", "piece_edge", "piece"});
+  if (select.contains("box") + select.contains("ball") + select.contains("piece_edge") + select.contains("piece") != 1)
+    r.fail(select_path, "give one of \"box\", \"ball\", \"piece_edge\" and \"piece\"");
   for (const char* key : {"piece_edge", "piece"})
     if (const Json* j = r.find(select, key)) {
       const std::string key_path = join_key(select_path, key);
@@ -154,6 +166,7 @@ std::vector<int> read_selection(const Reader& r, const Json& item, const std::st
       return std::string(key) == "piece" ? select_piece_region(r, *j, key_path, *pattern)
                                          : select_piece_edge(r, *j, key_path, *pattern);
     }
+  if (const Json* ball = r.find(select, "ball")) return select_in_ball(r, *ball, join_key(select_path, "ball"), mesh);
   return select_in_box(r, select["box"], join_key(select_path, "box"), mesh);
 }
 
@@ -445,6 +458,13 @@ std::vector<int> select_box(const Eigen::MatrixX3d& vertices, const Eigen::Vecto
     for (Eigen::Index k = 0; k < 3; ++k) inside = inside && vertices(v, k) >= lo[k] && vertices(v, k) <= hi[k];
     if (inside) out.push_back(static_cast<int>(v));
   }
+  return out;
+}
+
+std::vector<int> select_ball(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& center, double radius) {
+  std::vector<int> out;
+  for (Eigen::Index v = 0; v < vertices.rows(); ++v)
+    if ((vertices.row(v).transpose() - center).squaredNorm() <= radius * radius) out.push_back(static_cast<int>(v));
   return out;
 }
 

@@ -146,4 +146,7 @@ std::string time_limit_problem(const TimeSettings& t);
 std::vector<int> select_box(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& lo,
                             const Eigen::Vector3d& hi);
 
+// Indices (ascending) of the rows p of `vertices` [m] in the closed ball |p − center| <= radius [m].
+std::vector<int> select_ball(const Eigen::MatrixX3d& vertices, const Eigen::Vector3d& center, double radius);
+
 }  // namespace clothsim

@@ -31,10 +31,14 @@ DrapeMeasure measure_drape(const Eigen::MatrixX3d& vertices, const std::vector<s
     p(i, 0) = x.dot(e1);
     p(i, 1) = x.dot(e2);
   }
-  const double h = s.cell;
-  const double x0 = p.col(0).minCoeff() - 2 * h, y0 = p.col(1).minCoeff() - 2 * h;
+  if (!s.support_center.allFinite()) throw std::invalid_argument("measure_drape: the support's centre is not finite");
+  const Eigen::Vector2d axis(s.support_center.dot(e1), s.support_center.dot(e2));
+  const double h = s.cell, r0 = s.support_radius;
+  const double x0 = std::min(p.col(0).minCoeff(), axis.x() - r0) - 2 * h;
+  const double y0 = std::min(p.col(1).minCoeff(), axis.y() - r0) - 2 * h;
   // The cell counts, checked as doubles before they become integers.
-  const double cells_x = std::ceil((p.col(0).maxCoeff() - x0) / h) + 2, cells_y = std::ceil((p.col(1).maxCoeff() - y0) / h) + 2;
+  const double cells_x = std::ceil((std::max(p.col(0).maxCoeff(), axis.x() + r0) - x0) / h) + 2;
+  const double cells_y = std::ceil((std::max(p.col(1).maxCoeff(), axis.y() + r0) - y0) / h) + 2;
   if (!(cells_x * cells_y <= 1e8))
     throw std::invalid_argument("measure_drape: the shadow needs " + std::to_string(cells_x * cells_y) +
                                 " raster cells (more than 1e8): use a larger cell");
@@ -66,6 +70,13 @@ DrapeMeasure measure_drape(const Eigen::MatrixX3d& vertices, const std::vector<s
       }
     }
   }
+  // The support disc: a cell whose centre lies in it.
+  for (long long j = 0; j < ny; ++j)
+    for (long long i = 0; i < nx; ++i) {
+      const double dx = x0 + (static_cast<double>(i) + 0.5) * h - axis.x();
+      const double dy = y0 + (static_cast<double>(j) + 0.5) * h - axis.y();
+      if (dx * dx + dy * dy <= r0 * r0) grid[static_cast<size_t>(j * nx + i)] = 1;
+    }
   DrapeMeasure m;
   long long filled = 0, boundary = 0;
   double cx = 0, cy = 0;

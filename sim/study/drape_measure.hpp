@@ -2,7 +2,8 @@
 // the drape coefficient DC = (A_shadow − A_support) / (A_specimen − A_support), A_shadow the area
 // of the surface's vertical projection (its shadow from a light straight above), and the number
 // of nodes (folds) of the shadow's outline. The projection is along −up onto the plane normal to
-// `up`; the shadow is the union of the projected triangles, rasterised on a square grid.
+// `up`; the shadow is the union of the projected triangles and of the support disc (opaque, under
+// the specimen: a clamped specimen's mesh may leave its middle out), rasterised on a square grid.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +21,7 @@ struct DrapeMeasureSettings {
   int smoothing = 5;               // moving-average width of the outline radius [angular bins]
   int angles = 720;                // angular bins of the outline
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();  // the projection direction is −up
+  Eigen::Vector3d support_center = Eigen::Vector3d::Zero();  // a point on the support's axis [m]
 };
 
 struct DrapeMeasure {

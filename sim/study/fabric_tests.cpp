@@ -264,6 +264,24 @@ double shear_from_bias(double e45, double e_warp, double e_weft, double poisson)
 
 // ---- Cusick --------------------------------------------------------------------------------------
 
+namespace {
+
+// A specimen's OBJ: the vertices (x–z plane, normal +y), texture coordinates u = (x/R + 1)/2,
+// v = (1 − z/R)/2 (the warp along +x) and the triangles.
+std::string specimen_obj(const std::string& header, const std::vector<Eigen::Vector3d>& v,
+                         const std::vector<std::array<int, 3>>& f, double radius) {
+  std::ostringstream o;
+  o << std::setprecision(12) << "# " << header << ", " << v.size() << " vertices; vt: u along +x (warp), v along -z\n";
+  for (const auto& p : v) o << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
+  for (const auto& p : v) o << "vt " << (p.x() / radius + 1) / 2 << ' ' << (1 - p.z() / radius) / 2 << '\n';
+  for (const auto& t : f)
+    o << "f " << t[0] + 1 << '/' << t[0] + 1 << ' ' << t[1] + 1 << '/' << t[1] + 1 << ' ' << t[2] + 1 << '/' << t[2] + 1
+      << '\n';
+  return o.str();
+}
+
+}  // namespace
+
 std::string disc_obj(double radius, int rings) {
   if (rings < 1 || !(radius > 0)) throw std::invalid_argument("disc_obj: need radius > 0 and rings >= 1");
   std::vector<Eigen::Vector3d> v = {Eigen::Vector3d::Zero()};
@@ -288,23 +306,68 @@ std::string disc_obj(double radius, int rings) {
         if (i < k) f.push_back({at(k, in), at(k + 1, o + 1), at(k, in + 1)});
       }
     }
-  std::ostringstream o;
-  o << std::setprecision(12) << "# Cusick specimen: disc of radius " << radius << " m, " << rings << " rings, "
-    << v.size() << " vertices; vt: u along +x (warp), v along -z\n";
-  for (const auto& p : v) o << "v " << p.x() << ' ' << p.y() << ' ' << p.z() << '\n';
-  for (const auto& p : v) o << "vt " << (p.x() / radius + 1) / 2 << ' ' << (1 - p.z() / radius) / 2 << '\n';
-  for (const auto& t : f)
-    o << "f " << t[0] + 1 << '/' << t[0] + 1 << ' ' << t[1] + 1 << '/' << t[1] + 1 << ' ' << t[2] + 1 << '/' << t[2] + 1
-      << '\n';
-  return o.str();
+  std::ostringstream header;
+  header << "Cusick specimen: disc of radius " << radius << " m, " << rings << " rings";
+  return specimen_obj(header.str(), v, f, radius);
+}
+
+std::vector<int> default_cusick_rings(bool clamped) {
+  return clamped ? std::vector<int>{12, 16, 24} : std::vector<int>{16, 24, 32};
+}
+
+int annulus_around(double inner, double outer, int rings) {
+  const double q = std::pow(outer / inner, 1.0 / rings);
+  return static_cast<int>(std::lround(std::sqrt(3.0) * kPi / (q - 1)));
+}
+
+std::string annulus_obj(double inner, double outer, int rings, int inner_rings) {
+  if (!(inner > 0) || !(outer > inner) || rings < 1 || inner_rings < 0)
+    throw std::invalid_argument("annulus_obj: need 0 < inner < outer, rings >= 1 and inner_rings >= 0");
+  const double q = std::pow(outer / inner, 1.0 / rings);
+  const int m = annulus_around(inner, outer, rings);
+  if (m < 6) throw std::invalid_argument("annulus_obj: too few rings for an annulus this narrow");
+  std::vector<Eigen::Vector3d> v;
+  // Ring k (−inner_rings ≤ k ≤ rings) at radius inner·q^k, its m vertices turned by half a step
+  // from the ring inside: rows of nearly equilateral triangles.
+  for (int k = -inner_rings; k <= rings; ++k) {
+    const double r = k == rings ? outer : inner * std::pow(q, k);
+    for (int j = 0; j < m; ++j) {
+      const double t = 2 * kPi * (j + 0.5 * (k + inner_rings)) / m;
+      v.emplace_back(r * std::cos(t), 0.0, -r * std::sin(t));
+    }
+  }
+  const auto at = [&](int k, int j) { return (k + inner_rings) * m + j % m; };
+  std::vector<std::array<int, 3>> f;
+  for (int k = -inner_rings; k < rings; ++k)
+    for (int j = 0; j < m; ++j) {
+      // Counter-clockwise seen from +y (the angle grows from +x towards −z).
+      f.push_back({at(k, j), at(k + 1, j), at(k, j + 1)});
+      f.push_back({at(k + 1, j), at(k + 1, j + 1), at(k, j + 1)});
+    }
+  std::ostringstream header;
+  header << "Cusick specimen: annulus from " << inner << " m (" << inner_rings << " rings inside) to " << outer << " m, "
+         << rings << " rings of " << m;
+  return specimen_obj(header.str(), v, f, outer);
+}
+
+int cusick_vertices(const CusickSettings& s, int rings) {
+  if (!s.clamped) return 1 + 3 * rings * (rings + 1);
+  return (rings + 1 + s.clamped_rings) * annulus_around(s.support_radius, s.specimen_radius, rings);
+}
+
+std::string cusick_specimen_obj(const CusickSettings& s, int rings) {
+  return s.clamped ? annulus_obj(s.support_radius, s.specimen_radius, rings, s.clamped_rings)
+                   : disc_obj(s.specimen_radius, rings);
 }
 
 Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, const CusickSettings& s) {
   const double h = s.height;
   Json scene = {
       {"name", "cusick"},
-      {"description", "Cusick drape test (ISO 9073-9): the specimen disc lies centred on the support disc and drapes "
-                      "under gravity"},
+      {"description", s.clamped ? "Cusick drape test (ISO 9073-9): the specimen disc is clamped centred between the "
+                                  "support disc and an upper disc of the same size and drapes under gravity"
+                                : "Cusick drape test, loose: the specimen disc lies centred on the support disc (no upper "
+                                  "disc) and drapes under gravity"},
       {"analysis", "dynamic"},
       // An imperfection moves points by up to its amplitude either way: the disc is raised by it so
       // that it starts clear of the support.
@@ -319,7 +382,9 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
         {{"name", "support"},
          {"primitive", "cylinder"},
          {"from", {0, 0, 0}},
-         {"to", {0, h - s.thickness, 0}},
+         // Clamped, the specimen's middle is held by the clamp, not by contact: the support's top
+         // lies out of the contact's reach (2 thicknesses below it).
+         {"to", {0, h - (s.clamped ? 2 : 1) * s.thickness, 0}},
          {"radius", s.support_radius},
          {"friction", 0.4}}}},
       {"output", {{"obj", true}, {"obj_level", 2}}},
@@ -329,6 +394,13 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
        {{"background", {1, 1, 1}}, {"camera", {{"eye", {0.0, h + 0.5, 0.001}}, {"target", {0, h - 0.05, 0}}}}}},
   };
   if (s.imperfection > 0) scene["imperfection"] = Json{{"amplitude", s.imperfection}, {"seed", 1}};
+  if (s.clamped) {
+    // The clamp: every vertex up to the rim (the rim's ring lies at the support's radius, the next
+    // one at least 0.5 % farther out; selected on the flat placed disc, before any imperfection).
+    scene["boundary"] = Json::array({{{"select", {{"ball", {{"center", {0, h + s.imperfection, 0}},
+                                                            {"radius", s.support_radius * (1 + 1e-6)}}}}},
+                                      {"fix", {"x", "y", "z"}}}});
+  }
   return scene;
 }
 

@@ -126,10 +126,22 @@ double shear_from_bias(double e45, double e_warp, double e_weft, double poisson)
 
 // ---- Cusick drape test (ISO 9073-9) -----------------------------------------------------------------
 
+// The default meshes: clamped 12, 16, 24 rings across the annulus (1,875 to 6,831 vertices, about
+// 9 minutes on 2 cores), loose 16, 24, 32 rings of the disc (817 to 3,169 vertices).
+std::vector<int> default_cusick_rings(bool clamped);
+
 struct CusickSettings {
   double specimen_radius = 0.15, support_radius = 0.09;  // [m]
-  double height = 0.2;         // the support's top [m]
-  std::vector<int> rings = {16, 24, 32};  // meshes (rings of the disc), coarse to fine
+  double height = 0.2;         // the specimen's plane [m]
+  // The standard holds the specimen between the support disc and a disc of the same diameter on
+  // top: the specimen is then an annulus whose vertices up to the support's rim are fixed
+  // (`clamped_rings` rings inside the rim, so that the drawn surface is flat up to about one
+  // element inside it). false: the whole disc lies loose on the support (no upper disc).
+  bool clamped = true;
+  int clamped_rings = 2;
+  // Meshes, coarse to fine: clamped, the rings across the hanging annulus (graded, the finest at
+  // the rim; annulus_obj); loose, the rings of the disc (disc_obj). Default: default_cusick_rings.
+  std::vector<int> rings = default_cusick_rings(true);
   double end = 3.0;            // simulated time [s]
   double dt = 0.002;           // [s]
   double thickness = 0.001;    // contact thickness [m]
@@ -138,10 +150,22 @@ struct CusickSettings {
   // slowly onto its drape; the run lasts ramp + end. 0: the full weight at once (a drop).
   double ramp = 0.0;
 };
-// The specimen: a disc of `rings` rings (1 + 3N(N+1) vertices, ring k of 6k), in the x–z plane
-// with normal +y, texture coordinates u = (x/R + 1)/2, v = (1 − z/R)/2 (warp along +x).
+// The loose specimen: a disc of `rings` rings (1 + 3N(N+1) vertices, ring k of 6k), in the x–z
+// plane with normal +y, texture coordinates u = (x/R + 1)/2, v = (1 − z/R)/2 (warp along +x).
 std::string disc_obj(double radius, int rings);
-// The scene (the disc `disc_file`, relative to the scene, placed on the support).
+// The clamped specimen: an annulus from `inner` to `outer` [m] of `rings` rings across, ring k at
+// radius inner·q^k (q = (outer/inner)^(1/rings)), plus `inner_rings` rings inside `inner` (the
+// clamped part), each of annulus_around() vertices, every ring turned by half a step from the one
+// inside: nearly equilateral triangles whose size grows with the radius (the finest at the rim,
+// where the folds start). The same plane, normal and texture coordinates as disc_obj.
+std::string annulus_obj(double inner, double outer, int rings, int inner_rings);
+// The vertices per ring of annulus_obj: round(√3 π / (q − 1)).
+int annulus_around(double inner, double outer, int rings);
+// The specimen of `settings` with `rings` rings (annulus_obj or disc_obj) and its vertex count.
+std::string cusick_specimen_obj(const CusickSettings& settings, int rings);
+int cusick_vertices(const CusickSettings& settings, int rings);
+// The scene (the specimen `disc_file`, relative to the scene, placed on the support; clamped: its
+// vertices within the support's radius fixed).
 nlohmann::json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, const CusickSettings& settings);
 
 }  // namespace clothsim

@@ -64,6 +64,20 @@ TEST(FabricTestCli, SceneFileMaterialAndOneTest) {
   EXPECT_NE(read_file_bytes(tmp / "c" / "fabric_test_woven" / "fabric_test.md").find("Extrapolated to zero element size"),
             std::string::npos);
   EXPECT_FALSE(fs::exists(tmp / "fabric_test_woven" / "tensile_bias.png"));  // --no-render
+  // By default the specimen is clamped (an annulus held up to the rim); --loose lays the whole
+  // disc on the support.
+  const std::string clamped = read_file_bytes(tmp / "c" / "fabric_test_woven" / "runs" / "cusick_r5.json");
+  EXPECT_NE(clamped.find("\"ball\""), std::string::npos) << clamped;
+  EXPECT_NE(read_file_bytes(tmp / "c" / "fabric_test_woven" / "fabric_test.md").find("clamped between the support disc"),
+            std::string::npos);
+  ASSERT_EQ(run_shell(shell_quote(kClothsim) + " fabric-test " + shell_quote((tmp / "woven.json").string()) +
+                      " --tests cusick --quick --loose --rings 4,5 --no-render --out " + shell_quote((tmp / "l").string()) +
+                      " 2>/dev/null >/dev/null"),
+            0);
+  const std::string loose = read_file_bytes(tmp / "l" / "fabric_test_woven" / "runs" / "cusick_r5.json");
+  EXPECT_EQ(loose.find("\"boundary\""), std::string::npos) << loose;
+  EXPECT_NE(read_file_bytes(tmp / "l" / "fabric_test_woven" / "fabric_test.md").find("lying loose on a support disc"),
+            std::string::npos);
   fs::remove_all(tmp);
 }
 
@@ -81,6 +95,7 @@ TEST(FabricTestCli, BadInputNamesTheProblemAndWritesNothing) {
   fails_with("cotton --tests cantilever,drape", "--tests: no test \"drape\"");
   fails_with("cotton --rings 24,16", "--rings");
   fails_with("cotton --rings 16,x", "--rings");
+  fails_with("cotton --rings ,", "--rings: give at least one mesh");
   fails_with("cotton --imperfection -0.001", "--imperfection");
   fails_with("cotton --ramp -1", "--ramp");
   fails_with(shell_quote((tmp / "missing.json").string()), "missing.json");

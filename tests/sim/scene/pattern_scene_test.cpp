@@ -135,7 +135,7 @@ TEST_F(PatternScene, ErrorsNameTheKey) {
       "boundary": [{"select": {"piece_edge": {"piece": "front", "edge": 0}}, "fix": ["x"]}]})"),
                        "boundary[0].select.piece_edge: needs a pattern mesh"));
   EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"box": [[-1, -1, -1], [1, 1, 1]], "piece_edge": {"piece": "front", "edge": 0}}, "fix": ["x"]}])")),
-                       "boundary[0].select: give one of \"box\", \"piece_edge\" and \"piece\""));
+                       "boundary[0].select: give one of \"box\", \"ball\", \"piece_edge\" and \"piece\""));
   EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece": {"name": "fornt"}}, "fix": ["x"]}])")),
                        "boundary[0].select.piece.name: no piece \"fornt\""));
   EXPECT_TRUE(contains(error(dynamic(R"(, "boundary": [{"select": {"piece": {"name": "front", "box": [[1, 1], [2, 2]]}}, "fix": ["x"]}])")),

@@ -133,6 +133,35 @@ TEST_F(SceneLoader, BoundaryBoxSelectsOnPreparedMesh) {
   for (int v : bc.vertices) EXPECT_NEAR(s.problem.mesh.vertices(v, 1), -0.5, 1e-12);
 }
 
+TEST_F(SceneLoader, BoundaryBallIsClosedAndSelectsOnPreparedMesh) {
+  // The 5 × 5 grid's vertex (i, j) sits at (i/4 − 1/2, j/4 − 1/2, 0), index 5 j + i: the ball of
+  // radius 1/4 about the centre holds the centre and, closed, its four neighbours at distance 1/4
+  // (the diagonal ones lie at 0.354).
+  const TriMesh grid = make_grid(1.0, 1.0, 4, 4);
+  EXPECT_EQ(select_ball(grid.vertices, {0, 0, 0}, 0.25), (std::vector<int>{7, 11, 12, 13, 17}));
+  EXPECT_EQ(select_ball(grid.vertices, {0, 0, 0}, 0.2499), (std::vector<int>{12}));
+  EXPECT_EQ(select_ball(grid.vertices, {-0.5, -0.5, 0.1}, 0.11), (std::vector<int>{0}));
+  const Scene s = load(std::string("{") + kGrid4 +
+                       R"(, "boundary": [{"select": {"ball": {"center": [0, 0, 0], "radius": 0.3}}, "fix": ["y"]}]})");
+  ASSERT_EQ(s.problem.boundary.size(), 1u);
+  EXPECT_EQ(s.problem.boundary[0].vertices, (std::vector<int>{7, 11, 12, 13, 17}));
+  EXPECT_EQ(s.problem.boundary[0].fix, (std::array<bool, 3>{false, true, false}));
+}
+
+TEST_F(SceneLoader, BoundaryBallErrors) {
+  auto bc = [&](const std::string& item) { return error(std::string("{") + kGrid4 + R"(, "boundary": [)" + item + "]}"); };
+  EXPECT_EQ(bc(R"({"select": {"ball": {"center": [0, 0, 0], "radius": 0}}})"),
+            expected("boundary[0].select.ball.radius: must be > 0 [m] (got 0)"));
+  EXPECT_TRUE(contains(bc(R"({"select": {"ball": {"center": [3, 0, 0], "radius": 0.5}}})"),
+                       expected("boundary[0].select.ball: selects no vertex of the mesh")));
+  EXPECT_TRUE(contains(bc(R"({"select": {"ball": {"radius": 0.5}}})"),
+                       expected("boundary[0].select.ball.center: required key is missing")));
+  EXPECT_TRUE(contains(bc(R"({"select": {"ball": {"center": [0, 0, 0], "radius": 0.5, "r": 1}}})"),
+                       expected("boundary[0].select.ball.r: unknown key (allowed: center, radius)")));
+  EXPECT_TRUE(contains(bc(R"({"select": {"ball": {"center": [0, 0, 0], "radius": 0.5}, "box": [[-1, -1, -1], [1, 1, 1]]}})"),
+                       expected("boundary[0].select: give one of \"box\", \"ball\", \"piece_edge\" and \"piece\"")));
+}
+
 TEST_F(SceneLoader, NearestVertexTiesGoToLowestIndex) {
   Eigen::MatrixX3d v(4, 3);
   v << 1, 0, 0, 0, 0, 0, -1, 0, 0, 0, 1, 0;
@@ -154,7 +183,7 @@ TEST_F(SceneLoader, UnknownKeysAtAnyLevel) {
                        expected("mesh.radius: unknown key (allowed: primitive, size, divisions, rotate, translate, max_vertices, fit_limit)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 +
                              R"(, "boundary": [{"select": {"box": [[0, 0, 0], [1, 1, 1]], "sphere": 1}}]})"),
-                       expected("boundary[0].select.sphere: unknown key (allowed: box, piece_edge, piece)")));
+                       expected("boundary[0].select.sphere: unknown key (allowed: box, ball, piece_edge, piece)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "probes": [{"name": "a", "at": [0, 0, 0], "x": 1}]})"),
                        expected("probes[0].x: unknown key (allowed: name, at)")));
   EXPECT_TRUE(contains(error(std::string("{") + kGrid4 + R"(, "numerics": {"solver": "cg"}})"),

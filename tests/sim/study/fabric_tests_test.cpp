@@ -74,6 +74,23 @@ TEST(DrapeMeasure, RipplesOnTheOutlineAreNotNodes) {
   EXPECT_GT(measure_drape(v, f, s).nodes, 3);
 }
 
+TEST(DrapeMeasure, TheSupportDiscIsInTheShadow) {
+  // A clamped specimen's mesh leaves out its middle: a flat annulus from the support's rim to the
+  // specimen's edge casts, with the support under it, the shadow of the whole disc (DC 1).
+  const TriMesh ring = read_obj_text(annulus_obj(0.09, 0.15, 12, 0), "annulus.obj");
+  const DrapeMeasure m = measure_drape(ring.vertices, ring.triangles);
+  EXPECT_NEAR(m.drape_coefficient, 1.0, 0.01);
+  EXPECT_EQ(m.nodes, 0);
+  // A specimen smaller than the support, off its axis: the support disc still counts whole.
+  Eigen::MatrixX3d v;
+  std::vector<std::array<int, 3>> f;
+  star(0.03, 0.0, 0, 400, v, f);
+  DrapeMeasureSettings s;
+  s.support_center = Eigen::Vector3d(0.5, 0.0, -0.5);
+  const DrapeMeasure apart = measure_drape(v, f, s);
+  EXPECT_NEAR(apart.shadow_area, kPi * (0.03 * 0.03 + 0.09 * 0.09), 2 * apart.area_bound);
+}
+
 TEST(DrapeMeasure, BadInputIsRefused) {
   Eigen::MatrixX3d v(3, 3);
   v << 0, 0, 0, 1, 0, 0, 0, 0, 1;
@@ -102,6 +119,78 @@ TEST(FabricTest, DiscSpecimenMesh) {
   EXPECT_NEAR(area, 3 * rings * 0.15 * 0.15 * std::sin(2 * kPi / (6 * rings)), 1e-12);
 }
 
+TEST(FabricTest, AnnulusSpecimenMesh) {
+  // Rings at inner·q^k, k = −2 … N, of m vertices each: the rim's ring exactly at the support's
+  // radius, nearly equilateral triangles, every interior vertex of valence 6, normal +y, and the
+  // area between the outer and the innermost polygon.
+  const int rings = 10, inside = 2;
+  const double inner = 0.09, outer = 0.15;
+  const int m = annulus_around(inner, outer, rings);
+  const double q = std::pow(outer / inner, 1.0 / rings);
+  EXPECT_EQ(m, static_cast<int>(std::lround(std::sqrt(3.0) * kPi / (q - 1))));
+  const TriMesh a = read_obj_text(annulus_obj(inner, outer, rings, inside), "annulus.obj");
+  ASSERT_EQ(a.num_vertices(), (rings + 1 + inside) * m);
+  EXPECT_EQ(a.num_triangles(), 2 * (rings + inside) * m);
+  std::vector<int> valence(static_cast<size_t>(a.num_vertices()), 0);
+  double area = 0, worst = 1;
+  for (const auto& t : a.triangles) {
+    const Eigen::Vector3d p = a.vertices.row(t[0]), b = a.vertices.row(t[1]), c = a.vertices.row(t[2]);
+    const Eigen::Vector3d n = (b - p).cross(c - p);
+    EXPECT_GT(n.y(), 0);
+    area += 0.5 * n.norm();
+    const double e[3] = {(b - p).norm(), (c - b).norm(), (p - c).norm()};
+    worst = std::max(worst, std::max({e[0], e[1], e[2]}) / std::min({e[0], e[1], e[2]}));
+    for (const int v : t) ++valence[static_cast<size_t>(v)];
+  }
+  EXPECT_LT(worst, 1.1);
+  int on_rim = 0, inside_rim = 0;
+  for (Eigen::Index i = 0; i < a.vertices.rows(); ++i) {
+    const double r = std::hypot(a.vertices(i, 0), a.vertices(i, 2));
+    if (std::abs(r - inner) < 1e-12) ++on_rim;
+    if (r < inner - 1e-12) ++inside_rim;
+    // Border vertices (the innermost and the outer ring) have 3 triangles, the rest 6.
+    const bool border = r < inner / (q * q) * (1 + 1e-9) || r > outer * (1 - 1e-9);
+    if (!border) {
+      EXPECT_EQ(valence[static_cast<size_t>(i)], 6) << i;
+    }
+  }
+  EXPECT_EQ(on_rim, m);
+  EXPECT_EQ(inside_rim, inside * m);
+  const double r_in = inner / (q * q);
+  EXPECT_NEAR(area, 0.5 * m * std::sin(2 * kPi / m) * (outer * outer - r_in * r_in), 1e-12);
+  EXPECT_THROW(annulus_obj(0.15, 0.09, 4, 0), std::invalid_argument);
+}
+
+TEST(FabricTest, ClampedCusickHoldsTheSpecimenUpToTheRim) {
+  // The standard's upper disc: every vertex within the support's radius fixed, none beyond it,
+  // and the support's top out of the contact's reach of the clamped part.
+  const FabricUnderTest f = fabric_under_test("polyester_faille_ortho");
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "clothsim_cusick_clamp_test";
+  std::filesystem::create_directories(dir);
+  CusickSettings s;
+  ASSERT_TRUE(s.clamped);
+  std::ofstream(dir / "annulus.obj") << cusick_specimen_obj(s, 8);
+  for (const double a : {0.0, 0.003}) {
+    s.imperfection = a;
+    const Scene scene = load_scene_text(cusick_scene(f, "annulus.obj", s).dump(), dir / "cusick.json", {});
+    EXPECT_EQ(scene.problem.mesh.num_vertices(), cusick_vertices(s, 8));
+    ASSERT_EQ(scene.problem.boundary.size(), 1u);
+    const BoundaryCondition& clamp = scene.problem.boundary[0];
+    EXPECT_EQ(clamp.fix, (std::array<bool, 3>{true, true, true}));
+    std::vector<bool> held(static_cast<size_t>(scene.problem.mesh.num_vertices()), false);
+    for (const int v : clamp.vertices) held[static_cast<size_t>(v)] = true;
+    for (Eigen::Index i = 0; i < scene.problem.mesh.vertices.rows(); ++i) {
+      const double r = std::hypot(scene.problem.mesh.vertices(i, 0), scene.problem.mesh.vertices(i, 2));
+      EXPECT_EQ(held[static_cast<size_t>(i)], r <= s.support_radius * (1 + 1e-9)) << i << " at r = " << r;
+    }
+    EXPECT_EQ(static_cast<int>(clamp.vertices.size()), (s.clamped_rings + 1) * annulus_around(0.09, 0.15, 8));
+    const nlohmann::json support = cusick_scene(f, "annulus.obj", s).at("obstacles").at(1);
+    EXPECT_EQ(support.at("name"), "support");
+    EXPECT_DOUBLE_EQ(support.at("to").at(1).get<double>(), s.height - 2 * s.thickness);
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(FabricTest, CusickSpecimenStartsClearOfTheSupport) {
   // With and without a seeded imperfection, every control vertex starts at least the contact
   // thickness above the support's top (an imperfection of 2 mm on a 1 mm gap once started the
@@ -112,6 +201,7 @@ TEST(FabricTest, CusickSpecimenStartsClearOfTheSupport) {
   std::ofstream(dir / "disc.obj") << disc_obj(0.15, 8);
   for (const double a : {0.0, 0.002, 0.005}) {
     CusickSettings s;
+    s.clamped = false;  // loose on the support
     s.imperfection = a;
     const Scene scene = load_scene_text(cusick_scene(f, "disc.obj", s).dump(), dir / "cusick.json", {});
     const double top = s.height - s.thickness;  // the support's top
