@@ -395,6 +395,15 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
   };
   if (s.imperfection > 0) scene["imperfection"] = Json{{"amplitude", s.imperfection}, {"seed", 1}};
   if (s.clamped) {
+    // The upper disc, 5 mm thick, its underside out of the contact's reach of the clamped part
+    // (an imperfection moves the clamped part by up to its amplitude either way from h + amplitude)
+    // (the picture shows it where the clamped middle lies).
+    scene["obstacles"].push_back({{"name", "clamp"},
+                                  {"primitive", "cylinder"},
+                                  {"from", {0, h + 2 * s.imperfection + 2 * s.thickness, 0}},
+                                  {"to", {0, h + 2 * s.imperfection + 2 * s.thickness + 0.005, 0}},
+                                  {"radius", s.support_radius},
+                                  {"friction", 0.4}});
     // The clamp: every vertex up to the rim (the rim's ring lies at the support's radius, the next
     // one at least 0.5 % farther out; selected on the flat placed disc, before any imperfection).
     scene["boundary"] = Json::array({{{"select", {{"ball", {{"center", {0, h + s.imperfection, 0}},

@@ -187,6 +187,12 @@ TEST(FabricTest, ClampedCusickHoldsTheSpecimenUpToTheRim) {
     const nlohmann::json support = cusick_scene(f, "annulus.obj", s).at("obstacles").at(1);
     EXPECT_EQ(support.at("name"), "support");
     EXPECT_DOUBLE_EQ(support.at("to").at(1).get<double>(), s.height - 2 * s.thickness);
+    // The upper disc lies above every clamped vertex by at least twice the contact thickness.
+    const nlohmann::json upper = cusick_scene(f, "annulus.obj", s).at("obstacles").at(2);
+    EXPECT_EQ(upper.at("name"), "clamp");
+    double highest = -1e9;
+    for (const int v : clamp.vertices) highest = std::max(highest, scene.problem.mesh.vertices(v, 1));
+    EXPECT_GE(upper.at("from").at(1).get<double>() - highest, 2 * s.thickness - 1e-12) << a;
   }
   std::filesystem::remove_all(dir);
 }
