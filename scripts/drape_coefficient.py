@@ -88,9 +88,9 @@ def shadow(pts, tris, h, r0):
     nx = int(math.ceil((max(xs) - x0) / h)) + 2
     nz = int(math.ceil((max(zs) - z0) / h)) + 2
     grid = rasterise(pts, tris, h, x0, z0, nx, nz)
-    for j in range(nz):
+    for j in range(max(0, int((-r0 - z0) / h) - 1), min(nz, int((r0 - z0) / h) + 2)):
         pz = z0 + (j + 0.5) * h
-        for i in range(nx):
+        for i in range(max(0, int((-r0 - x0) / h) - 1), min(nx, int((r0 - x0) / h) + 2)):
             px = x0 + (i + 0.5) * h
             if px * px + pz * pz <= r0 * r0:
                 grid[j * nx + i] = 1

@@ -395,9 +395,9 @@ Json cusick_scene(const FabricUnderTest& fabric, const std::string& disc_file, c
   };
   if (s.imperfection > 0) scene["imperfection"] = Json{{"amplitude", s.imperfection}, {"seed", 1}};
   if (s.clamped) {
-    // The upper disc, 5 mm thick, its underside out of the contact's reach of the clamped part
-    // (an imperfection moves the clamped part by up to its amplitude either way from h + amplitude)
-    // (the picture shows it where the clamped middle lies).
+    // The upper disc (the picture shows it over the clamped middle), 5 mm thick, its underside
+    // out of the contact's reach of the clamped part, which an imperfection moves by up to its
+    // amplitude either way from h + amplitude.
     scene["obstacles"].push_back({{"name", "clamp"},
                                   {"primitive", "cylinder"},
                                   {"from", {0, h + 2 * s.imperfection + 2 * s.thickness, 0}},

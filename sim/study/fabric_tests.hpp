@@ -126,8 +126,9 @@ double shear_from_bias(double e45, double e_warp, double e_weft, double poisson)
 
 // ---- Cusick drape test (ISO 9073-9) -----------------------------------------------------------------
 
-// The default meshes: clamped 12, 16, 24 rings across the annulus (1,875 to 6,831 vertices, about
-// 9 minutes on 2 cores), loose 16, 24, 32 rings of the disc (817 to 3,169 vertices).
+// The default meshes: clamped 12, 16, 24 rings across the annulus (1,875 to 6,831 vertices; the
+// four Kawabata fabrics took 5–7 minutes each on 2 cores), loose 16, 24, 32 rings of the disc
+// (817 to 3,169 vertices).
 std::vector<int> default_cusick_rings(bool clamped);
 
 struct CusickSettings {
