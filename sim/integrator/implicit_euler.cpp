@@ -201,6 +201,8 @@ LinearSolveReport ImplicitEuler::solve_with_potential(Eigen::SparseMatrix<double
     total.residual = r.residual;
     total.factorizations += r.factorizations;
     total.factor_ms += r.factor_ms;
+    total.direct_fallbacks += r.direct_fallbacks;
+    if (total.fallback_reason.empty()) total.fallback_reason = r.fallback_reason;
     ++iterations;
     if (!r.converged) {
       total.converged = false;
@@ -420,6 +422,8 @@ StepStats ImplicitEuler::step(DynamicState& state) {
     stats.residual = report.residual;
     stats.factorizations += report.factorizations;
     stats.factor_ms += report.factor_ms;
+    stats.direct_fallbacks += report.direct_fallbacks;
+    if (stats.direct_fallback_reason.empty()) stats.direct_fallback_reason = report.fallback_reason;
     stats.solve_ms += ms_since(t0);
     if (!report.converged) throw SimulationError(step_number, t_next, report.failure, SimulationError::Kind::solver);
     if (k > 0) stats.newton_change = (v_next - v_k).norm() / std::max(v_next.norm(), 1e-300);

@@ -79,6 +79,10 @@ struct StepStats {
   double solve_ms = 0.0;         // linear solve (with any factorisation)
   int factorizations = 0;        // Cholesky factorisations in this step (direct solve or preconditioner)
   double factor_ms = 0.0;        // their time, part of solve_ms
+  // Linear solves of the step that conjugate gradients failed and the direct solver finished
+  // (LinearSolveReport::direct_fallbacks), and why the first of them was needed.
+  int direct_fallbacks = 0;
+  std::string direct_fallback_reason;
   double kinetic_energy = 0.0;   // ½ vᵀ M v [J]
   double elastic_energy = 0.0;   // energy of the internal terms [J]
   double external_work = 0.0;    // work of the external loads on the free components this step [J]

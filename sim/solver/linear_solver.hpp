@@ -53,6 +53,11 @@ struct LinearSolveReport {
   int factorizations = 0;   // Cholesky factorisations in this solve (direct, or the preconditioner's)
   double factor_ms = 0.0;   // their time [ms]
   std::string failure;      // why it did not converge (a sentence with advice), when !converged
+  // Conjugate-gradient solves that failed (after the refactorised retry) and were finished by the
+  // direct solver (CHOLMOD) on the same matrix (0 or 1), and the failure that made them necessary
+  // (the sentence `failure` would have held).
+  int direct_fallbacks = 0;
+  std::string fallback_reason;
 };
 
 // What a run must save to continue later with bit-identical solves: the Cholesky preconditioner's
@@ -76,6 +81,9 @@ class LinearSolver {
   // Solves A x = b on the entries with free[i] != 0 (A symmetric positive definite there, full
   // storage, the pattern of every call the same); x holds the start (pcg) and, at the other
   // entries, their fixed values. A and b may be overwritten (the direct solver's Dirichlet form).
+  // A pcg solve that does not converge (after a refactorised retry with the Cholesky
+  // preconditioner) is solved once more by the direct solver (CHOLMOD) and counted in the
+  // report's direct_fallbacks; it fails only if that fails too.
   LinearSolveReport solve(Eigen::SparseMatrix<double>& a, Eigen::VectorXd& b, const std::vector<char>& free,
                           Eigen::VectorXd& x);
 
@@ -118,6 +126,11 @@ class LinearSolver {
   LinearSolveReport pcg_with_factor(const std::function<PcgResult(int, const Preconditioner&)>& pcg,
                                     const std::function<void(LinearSolveReport&)>& refactor, double entries,
                                     Eigen::VectorXd& x);
+  // After a conjugate-gradient solve that failed (`report`): A x = b solved by a direct
+  // factorisation of A, counted in `report` (direct_fallbacks; still not converged, with the
+  // reason added to its failure, when A is not positive definite on the free entries).
+  void solve_directly(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const std::vector<char>& free,
+                      Eigen::VectorXd& x, LinearSolveReport& report) const;
   LinearSolverSettings settings_;
   std::unique_ptr<Impl> impl_;
 };
