@@ -229,7 +229,7 @@ class Outputs {
       : scene_(scene), dir_(dir), images_(images), probes_(dir / "probes.csv", resume), stats_(dir / "stats.csv", resume) {
     if (resume) return;
     probes_.line("step,t,name,ux,uy,uz");
-    stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms") +
+    stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms,direct_fallbacks") +
                 (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy,contact_relinearisations" : ""));
     probes_.flush();
     stats_.flush();
@@ -338,7 +338,8 @@ class Outputs {
          {format_double(s.t), std::to_string(s.solver_iterations), format_double(s.residual),
           format_double(s.rotate_ms), format_double(s.assemble_ms), format_double(s.solve_ms),
           format_double(s.kinetic_energy), format_double(s.elastic_energy), format_double(s.external_work),
-          format_double(s.boundary_work), std::to_string(s.factorizations), format_double(s.factor_ms)})
+          format_double(s.boundary_work), std::to_string(s.factorizations), format_double(s.factor_ms),
+          std::to_string(s.direct_fallbacks)})
       row.append(1, ',').append(field);
     if (scene_.problem.has_contact())
       for (const std::string& field :
@@ -578,6 +579,7 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
                        "cloth is taken to be joined there");
   for (const std::string& w : warnings) log_line("warning: " + w);
   std::vector<int> unresolved_steps;  // steps that ended with contact pairs still colliding
+  std::vector<int> fallback_steps;    // steps whose linear solve the direct solver finished
   if (resume)
     log_line("resuming " + run_dir.string() + " at step " + std::to_string(first_step) + " (t = " +
              format_short(resume->sim.state.t) + " s) of " + std::to_string(steps));
@@ -695,6 +697,15 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
                      " contact pair(s) still colliding at the end of the step; frames from this time on may show "
                      "crossing surfaces (stats.csv: contact_unresolved)");
           }
+          if (s.direct_fallbacks > 0) {
+            // Conjugate gradients failed and the direct solver finished the solve (LinearSolver::solve):
+            // the step is as accurate as with "cholmod", but a solver that fails may need other settings.
+            fallback_steps.push_back(s.step);
+            log_line("warning: step " + std::to_string(s.step) + " (t = " + format_short(s.t) + " s): " +
+                     std::to_string(s.direct_fallbacks) +
+                     " linear solve(s) fell back to the direct solver (CHOLMOD), which solved them: " +
+                     s.direct_fallback_reason + " (stats.csv: direct_fallbacks)");
+          }
           const int frames_before = totals.frames;
           outputs->record_stats(s);
           outputs->record_state(*sim, s.step, s.t, totals);
@@ -760,6 +771,13 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
     warnings.push_back("contact: " + std::to_string(unresolved_steps.size()) +
                        " step(s) ended with contact pairs still colliding (steps " + list +
                        "); frames from those times on may show crossing surfaces");
+  }
+  if (!fallback_steps.empty()) {
+    std::string list;
+    for (size_t i = 0; i < fallback_steps.size() && i < 20; ++i) list += (i ? ", " : "") + std::to_string(fallback_steps[i]);
+    if (fallback_steps.size() > 20) list += ", ...";
+    warnings.push_back("solver: the conjugate gradient solver did not converge in " + std::to_string(fallback_steps.size()) +
+                       " step(s) (steps " + list + "); the direct solver (CHOLMOD) solved them instead (see the log)");
   }
   const std::string summary = summary_json(scene, totals, sim->settle_report(), wall(), warnings, status, failure);
   try {
