@@ -15,7 +15,9 @@ constexpr std::string_view kMagic = "clothsim checkpoint\n";
 constexpr std::string_view kEnd = "end\n";
 // 2: RunTotals::contact_response_factorizations; 3: the coupled pattern; 4: RunTotals::contact as
 // ContactCounters; 5: ContactCounters::relinearisations, IntegratorCheckpoint::contact_last_step;
-// 6: stats.csv's direct_fallbacks column (a run of version 5 resumed would get rows longer than its header).
+// 6: stats.csv's direct_fallbacks column (a run of version 5 resumed would get rows longer than its
+// header) and ContactCounters' step times (first solve, Newton's solves, line search, candidates,
+// fail-safe, steps with and without contact).
 constexpr std::uint32_t kVersion = 6;
 
 class Writer {

@@ -215,7 +215,19 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, const Sett
                     {"method", scene.problem.collision.barrier ? "barrier" : "constraints"},
                     {"barrier_seconds", totals.contact.potential_ms / 1000.0},
                     {"newton_iterations", totals.contact.newton_iterations},
-                    {"relinearisations", totals.contact.relinearisations}};
+                    {"relinearisations", totals.contact.relinearisations},
+                    // Where a step's time goes (docs/performance.md, "Where a garment's step goes"):
+                    // the linear solves of steps with contact, the step's first one and Newton's
+                    // further ones, and the potential's parts.
+                    {"first_solve_seconds", totals.contact.first_solve_ms / 1000.0},
+                    {"newton_solve_seconds", totals.contact.newton_solve_ms / 1000.0},
+                    {"line_search_seconds", totals.contact.line_search_ms / 1000.0},
+                    {"candidates_seconds", totals.contact.candidates_ms / 1000.0},
+                    {"failsafe_seconds", totals.contact.failsafe_ms / 1000.0},
+                    {"contact_steps", totals.contact.contact_steps},
+                    {"contact_step_seconds", totals.contact.contact_step_ms / 1000.0},
+                    {"free_steps", totals.steps - totals.contact.contact_steps},
+                    {"free_step_seconds", totals.contact.free_step_ms / 1000.0}};
   if (!error.empty()) j["error"] = error;
   return j.dump(2) + "\n";
 }
@@ -230,7 +242,7 @@ class Outputs {
     if (resume) return;
     probes_.line("step,t,name,ux,uy,uz");
     stats_.line(std::string("step,t,solver_iterations,residual,rotate_ms,assemble_ms,solve_ms,kinetic_energy,elastic_energy,external_work,boundary_work,factorizations,factor_ms,direct_fallbacks") +
-                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy,contact_relinearisations" : ""));
+                (scene.problem.has_contact() ? ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy,contact_relinearisations,step_ms,first_solve_ms,newton_solve_ms,barrier_ms,line_search_ms,candidates_ms,failsafe_ms" : ""));
     probes_.flush();
     stats_.flush();
     if (scene.write_obj_frames) fs::create_directory(dir / "frames");
@@ -347,7 +359,11 @@ class Outputs {
             std::to_string(s.contact.unresolved), format_double(s.contact.ms), std::to_string(s.contact.response_iterations),
             std::to_string(s.contact.response_cg_iterations), std::to_string(s.contact.response_factorizations),
             std::to_string(s.contact.newton_iterations), std::to_string(s.contact_active_pairs), format_double(s.contact_energy),
-            std::to_string(s.contact.relinearisations)})
+            std::to_string(s.contact.relinearisations), format_double(s.step_ms), format_double(s.contact.first_solve_ms),
+            format_double(s.contact.newton_solve_ms),
+            format_double(s.contact.potential_ms - s.contact.line_search_ms - s.contact.candidates_ms),
+            format_double(s.contact.line_search_ms), format_double(s.contact.candidates_ms),
+            format_double(s.contact.failsafe_ms)})
         row.append(1, ',').append(field);
     stats_.line(row);  // flushed by record_state, together with the probes
   }
@@ -479,6 +495,25 @@ void print_summary(const Scene& scene, const Simulator& sim, const RunTotals& to
     << " s, wall time " << wall_seconds << " s (rotate " << totals.rotate_ms / 1000.0 << " s, assemble "
     << totals.assemble_ms / 1000.0 << " s, solve " << totals.solve_ms / 1000.0 << " s)\n";
   s << "  max solver iterations per step " << totals.max_solver_iterations << "\n";
+  if (scene.problem.has_contact()) {
+    // The whole step where contact acted against one where it did not (a free step of the same
+    // scene), and where the contact steps' time went.
+    const ContactCounters& c = totals.contact;
+    const long long free_steps = totals.steps - c.contact_steps;
+    s << "  contact: " << c.contact_steps << " steps with contact, " << free_steps << " without";
+    if (c.contact_steps > 0) s << "; a step with contact " << c.contact_step_ms / static_cast<double>(c.contact_steps) << " ms";
+    if (free_steps > 0) s << ", without " << c.free_step_ms / static_cast<double>(free_steps) << " ms";
+    if (c.contact_steps > 0 && free_steps > 0 && c.free_step_ms > 0)
+      s << " (" << (c.contact_step_ms / static_cast<double>(c.contact_steps)) / (c.free_step_ms / static_cast<double>(free_steps))
+        << " times)";
+    s << "\n";
+    if (c.contact_steps > 0)
+      s << "  contact steps: " << static_cast<double>(c.newton_iterations) / static_cast<double>(c.contact_steps)
+        << " Newton solves each; of all steps' time: first solves " << c.first_solve_ms / 1000.0 << " s, Newton's further solves "
+        << c.newton_solve_ms / 1000.0 << " s, barrier " << (c.potential_ms - c.line_search_ms - c.candidates_ms) / 1000.0
+        << " s, CCD line search " << c.line_search_ms / 1000.0 << " s, candidate search " << c.candidates_ms / 1000.0
+        << " s, fail-safe " << c.failsafe_ms / 1000.0 << " s (" << c.impulses << " impulses)\n";
+  }
   if (!scene.probes.empty()) {
     const Eigen::MatrixX3d u = sim.node_points() - sim.node_points_rest();
     for (const Probe& p : scene.probes)

@@ -83,8 +83,13 @@ class BarrierPotential {
   double step_bound(StepPositions& step, const Eigen::VectorXd& from, const Eigen::VectorXd& to);
   // Velocities within this of each other are the same to the potential (StepPotential) [m/s].
   double velocity_tolerance(double h) const;
-  // StepPotential::end_step: reports the step's pairs with lagged friction.
-  void end_step(PotentialReport& report) const { report.friction_pairs = static_cast<int>(friction_rows_.size()); }
+  // StepPotential::end_step: reports the step's pairs with lagged friction and the time its
+  // candidate searches took (from begin_step on).
+  void end_step(PotentialReport& report) {
+    report.friction_pairs = static_cast<int>(friction_rows_.size());
+    report.candidates_ms = candidates_ms_;
+    candidates_ms_ = 0.0;
+  }
 
   // --- What the fail-safe shares ---
   // Whether begin_step started this step (from x at t, length h).
@@ -175,6 +180,7 @@ class BarrierPotential {
   // every motion between two, whose points (and obstacle vertices) each stay within serve_radius()
   // of the straight path from the start to the end point they were made for (barrier_potential.cpp).
   std::vector<Candidate> cands_;
+  double candidates_ms_ = 0.0;  // the step's candidate searches so far [ms] (end_step reports it)
   Eigen::MatrixX3d guess_, built_p0_, built_o0_, built_o1_;
   long long builds_ = 0;
   bool obstacles_serve_ = false;       // the obstacles over this step (check_obstacles_serve)

@@ -20,7 +20,17 @@ struct ContactCounters {
                                           // their end positions (rotations that turned within the step)
   double ms = 0.0;                        // all of contact's time [ms]; of it:
   double broad_ms = 0.0, narrow_ms = 0.0, response_ms = 0.0;  // the fail-safe's phases [ms]
-  double potential_ms = 0.0;              // evaluating the contact potential inside the step [ms]
+  double potential_ms = 0.0;              // the contact potential inside the step [ms]; of it:
+  double candidates_ms = 0.0;             //   its candidate search (broad phases) [ms]
+  double line_search_ms = 0.0;            //   the CCD step bounds on Newton's moves [ms]
+  double failsafe_ms = 0.0;               // the fail-safe after the step (filter), part of ms [ms]
+  // Not part of ms (booked as the solve): the linear solves of steps where the potential acted,
+  // the step's first solve and Newton's further solves apart [ms].
+  double first_solve_ms = 0.0, newton_solve_ms = 0.0;
+  long long contact_steps = 0;            // steps in which contact acted (a pair active, friction,
+                                          // or a fail-safe impulse)
+  double contact_step_ms = 0.0;           // their whole time [ms]
+  double free_step_ms = 0.0;              // the whole time of the other steps [ms]
 
   ContactCounters& operator+=(const ContactCounters& o) {
     pairs_tested += o.pairs_tested;
@@ -37,6 +47,14 @@ struct ContactCounters {
     narrow_ms += o.narrow_ms;
     response_ms += o.response_ms;
     potential_ms += o.potential_ms;
+    candidates_ms += o.candidates_ms;
+    line_search_ms += o.line_search_ms;
+    failsafe_ms += o.failsafe_ms;
+    first_solve_ms += o.first_solve_ms;
+    newton_solve_ms += o.newton_solve_ms;
+    contact_steps += o.contact_steps;
+    contact_step_ms += o.contact_step_ms;
+    free_step_ms += o.free_step_ms;
     return *this;
   }
 };

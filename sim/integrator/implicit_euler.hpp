@@ -32,6 +32,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -83,6 +84,7 @@ struct StepStats {
   // (LinearSolveReport::direct_fallbacks), and why the first of them was needed.
   int direct_fallbacks = 0;
   std::string direct_fallback_reason;
+  double step_ms = 0.0;          // the whole step (ImplicitEuler::step) [ms]
   double kinetic_energy = 0.0;   // ½ vᵀ M v [J]
   double elastic_energy = 0.0;   // energy of the internal terms [J]
   double external_work = 0.0;    // work of the external loads on the free components this step [J]
@@ -248,9 +250,14 @@ class ImplicitEuler {
   // velocity at the start of the step; a and b are the elastic system. `first`: the step's first
   // linearisation of the elastic terms (the potential starts its step; later ones continue from
   // v, already free of crossings). Sets potential_acted_ where the potential is something.
+  // `turned`, when given, is asked once Newton has taken kTurnCheck steps whether the elastic
+  // terms' frames at the iterate's end positions turned beyond the rotation tolerance (it then
+  // leaves the terms evaluated there); if so Newton stops there and newton_turned_ is set, so that
+  // the step is linearised again without converging a linearisation it will discard.
   LinearSolveReport solve_with_potential(Eigen::SparseMatrix<double>& a, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
                                          const Eigen::VectorXd& v_now, double t, double h, bool first, Eigen::VectorXd& v,
-                                         StepStats& stats);
+                                         StepStats& stats, const std::function<bool(const Eigen::VectorXd&)>* turned = nullptr);
+  bool newton_turned_ = false;  // the last solve_with_potential stopped for a turn (above)
   // Ends the potential's step at the accepted velocities v.
   void finish_potential(const Eigen::VectorXd& v, StepStats& stats);
   // The end positions of velocities v from x, as the step's end makes them: scripted components

@@ -194,7 +194,7 @@ bool LinearSolver::solves_operators() const {
 
 LinearSolveReport LinearSolver::solve(const LinearOperator& product, double product_entries, const MatrixSource& assemble,
                                       const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
-                                      const Eigen::VectorXd* initial_residual) {
+                                      const Eigen::VectorXd* initial_residual, double forcing) {
   if (!solves_operators())
     throw std::logic_error("LinearSolver::solve: a matrix given as an operation needs pcg with the cholesky preconditioner");
   Impl& m = *impl_;
@@ -210,10 +210,10 @@ LinearSolveReport LinearSolver::solve(const LinearOperator& product, double prod
   const Eigen::VectorXd start = x;
   auto pcg = [&](int limit, const Preconditioner& factor) {
     const Eigen::VectorXd* r0 = initial_residual != nullptr && x == start ? initial_residual : nullptr;
-    if (factor) return solve_pcg(product, b, free, x, settings_.tolerance, limit, factor, r0);
+    if (factor) return solve_pcg(product, b, free, x, settings_.tolerance, limit, factor, r0, forcing);
     // (no factor: its factorisation, just made, failed; block Jacobi of the matrix it was of)
     if (assembled == nullptr) throw std::logic_error("LinearSolver::solve: no factor and no matrix");
-    return solve_pcg(product, b, free, x, settings_.tolerance, limit, block_jacobi(*assembled, free), r0);
+    return solve_pcg(product, b, free, x, settings_.tolerance, limit, block_jacobi(*assembled, free), r0, forcing);
   };
   LinearSolveReport report = pcg_with_factor(pcg, refactor, product_entries, x);
   // (A failed solve was refactorised, so the matrix is assembled already.)

@@ -97,10 +97,11 @@ class LinearSolver {
   // the last assembled matrix, kept while it serves (the same refresh rule as solve()).
   using MatrixSource = std::function<Eigen::SparseMatrix<double>&()>;
   bool solves_operators() const;
-  // `initial_residual`, when given, is b − A x for the start x (solve_pcg).
+  // `initial_residual`, when given, is b − A x for the start x; `forcing`, the fraction of the
+  // start's residual that also ends the solve (solve_pcg: an inexact Newton step).
   LinearSolveReport solve(const LinearOperator& product, double product_entries, const MatrixSource& assemble,
                           const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
-                          const Eigen::VectorXd* initial_residual = nullptr);
+                          const Eigen::VectorXd* initial_residual = nullptr, double forcing = 0.0);
 
   // An approximate inverse of the matrix of the last solve, `a` (as solve() left it) on the
   // entries with free[i] != 0, for further systems with that matrix or one close to it (the

@@ -4,6 +4,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -53,11 +54,13 @@ namespace {
 // Conjugate gradients from the residual r = b − A x (zero at the constrained entries), with
 // `apply` giving q = A p on the free entries and `precondition` z = P⁻¹ r.
 PcgResult iterate(const LinearOperator& apply, const Preconditioner& precondition, double b_norm, Eigen::VectorXd& r,
-                  Eigen::VectorXd& x, double tolerance, int max_iterations) {
+                  Eigen::VectorXd& x, double tolerance, int max_iterations, double forcing = 0.0) {
   const Eigen::Index n = r.size();
   const double scale = b_norm > 0 ? b_norm : 1.0;
   PcgResult result;
   result.residual = r.norm() / scale;
+  // (With a forcing term, also converged once the residual is that fraction of the start's.)
+  tolerance = std::max(tolerance, forcing * result.residual);
   if (result.residual <= tolerance) {
     result.converged = true;
     return result;
@@ -138,7 +141,7 @@ PcgResult solve_pcg(const Eigen::SparseMatrix<double>& a, const Eigen::VectorXd&
 
 PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
                     double tolerance, int max_iterations, const Preconditioner& preconditioner,
-                    const Eigen::VectorXd* initial_residual) {
+                    const Eigen::VectorXd* initial_residual, double forcing) {
   const Eigen::VectorXd mask = free_mask(free);
   const Preconditioner precondition = [&](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
     preconditioner(r, z);
@@ -156,7 +159,7 @@ PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std
     a(p, q);
     q = q.cwiseProduct(mask);
   };
-  return iterate(apply, precondition, b.cwiseProduct(mask).norm(), r, x, tolerance, max_iterations);
+  return iterate(apply, precondition, b.cwiseProduct(mask).norm(), r, x, tolerance, max_iterations, forcing);
 }
 
 }  // namespace clothsim

@@ -34,10 +34,12 @@ using LinearOperator = std::function<void(const Eigen::VectorXd& x, Eigen::Vecto
 // The same iteration for an operator A (symmetric positive definite on the free entries) and a
 // preconditioner (required here): x holds the warm start; b and x are zero at the constrained
 // entries (the operator does not see their values). `initial_residual`, when given, is b − A x for
-// the warm start, which the caller had (one product less).
+// the warm start, which the caller had (one product less). `forcing` η ∈ [0, 1): the solve is also
+// converged once ‖b − A x‖ ≤ η ‖b − A x₀‖ (an inexact Newton step's forcing term; 0: only the
+// tolerance relative to ‖b‖).
 PcgResult solve_pcg(const LinearOperator& a, const Eigen::VectorXd& b, const std::vector<char>& free, Eigen::VectorXd& x,
                     double tolerance, int max_iterations, const Preconditioner& preconditioner,
-                    const Eigen::VectorXd* initial_residual = nullptr);
+                    const Eigen::VectorXd* initial_residual = nullptr, double forcing = 0.0);
 
 // 1 for the free entries, 0 for the others.
 Eigen::VectorXd free_mask(const std::vector<char>& free);

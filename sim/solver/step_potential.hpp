@@ -58,6 +58,7 @@ struct PotentialReport {
   int active_pairs = 0;       // barrier pairs active at the end of the step
   int friction_pairs = 0;     // pairs with lagged friction in the step
   double energy = 0.0;        // E at the end of the step [J]
+  double candidates_ms = 0.0; // the potential's candidate searches in the step [ms]
 };
 
 class StepPotential {

@@ -565,6 +565,64 @@ TEST_F(ContactKeysCli, ResponseFiguresSumTheirColumns) {
   expect_sums("press_barrier", {{"contact_newton_iterations", "newton_iterations"}});
 }
 
+// Where a step's time goes is booked apart (issue 44): per stats.csv row the parts (the first
+// solve, Newton's further solves, the barrier, the CCD line search, the candidate search, the
+// fail-safe) are not negative and add up to at most the whole step; Newton's further solves take
+// time exactly in the rows with more than one Newton solve; summary.json's steps with and without
+// contact count every step and their times add up to the rows' step times.
+TEST_F(ContactKeysCli, StepTimesAreBookedApart) {
+  const fs::path scene = write("booked.json", R"({"name": "booked", "analysis": "dynamic",
+      "mesh": {"primitive": "grid", "size": [0.2, 0.2], "divisions": [8, 8],
+               "rotate": {"axis": [1, 0, 0], "angle_deg": -90}, "translate": [0, 0.004, 0]},
+      "material": {"preset": "cotton"},
+      "loads": {"gravity": [0, -9.81, 0]},
+      "initial": {"velocity": [0, -0.5, 0]},
+      "time": {"dt": 0.002, "end": 0.02, "output_fps": 50},
+      "collision": {"thickness": 0.002, "friction": 0.5, "self": true},
+      "obstacles": [{"name": "ground", "primitive": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}]})");
+  const RunResult r = run_scene(scene, "--no-render");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::istringstream in(clothsim::testing::read_file_bytes(out() / "booked" / "stats.csv"));
+  std::string field;
+  std::getline(in, field);
+  std::map<std::string, std::size_t> column;
+  {
+    std::istringstream header(field);
+    for (std::size_t k = 0; std::getline(header, field, ','); ++k) column[field] = k;
+  }
+  const std::vector<std::string> parts = {"first_solve_ms", "newton_solve_ms", "barrier_ms", "line_search_ms", "candidates_ms",
+                                          "failsafe_ms"};
+  for (const std::string& c : parts) ASSERT_EQ(column.count(c), 1u) << c;
+  ASSERT_EQ(column.count("step_ms"), 1u);
+  double step_sum = 0.0;
+  int rows = 0, multi_newton = 0, free_rows = 0;
+  for (std::string row; std::getline(in, row); ++rows) {
+    std::vector<std::string> f;
+    for (std::istringstream fields(row); std::getline(fields, field, ',');) f.push_back(field);
+    auto value = [&](const std::string& c) { return std::stod(f.at(column.at(c))); };
+    double sum = 0.0;
+    for (const std::string& c : parts) {
+      EXPECT_GE(value(c), 0.0) << c << " in " << row;
+      sum += value(c);
+    }
+    EXPECT_LE(sum, value("step_ms") * (1 + 1e-6) + 1e-6) << row;
+    const int newton = static_cast<int>(value("contact_newton_iterations"));
+    if (newton > 1) ++multi_newton;
+    if (newton == 0) ++free_rows;
+    EXPECT_EQ(value("newton_solve_ms") > 0, newton > 1) << row;
+    step_sum += value("step_ms");
+  }
+  EXPECT_EQ(rows, 10);
+  EXPECT_GT(multi_newton, 0);  // the sheet lands within the run: Newton works in some steps
+  const nlohmann::json c = nlohmann::json::parse(clothsim::testing::read_file_bytes(out() / "booked" / "summary.json"))["contact"];
+  EXPECT_EQ(c["contact_steps"].get<long long>() + c["free_steps"].get<long long>(), rows);
+  EXPECT_GT(c["contact_steps"].get<long long>(), 0);
+  EXPECT_GE(c["free_steps"].get<long long>(), free_rows);  // (a step without Newton saw no contact)
+  EXPECT_NEAR(c["contact_step_seconds"].get<double>() + c["free_step_seconds"].get<double>(), step_sum / 1000.0,
+              1e-6 * step_sum / 1000.0 + 1e-9);
+  EXPECT_TRUE(contains(r.out, "steps with contact")) << r.out;
+}
+
 // A short run: the contact figures appear in stats.csv and summary.json only with contact, and
 // OBJ frames at obj_level 1 hold the refined surface with vertex normals.
 TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
@@ -594,7 +652,8 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
   };
   const std::string contact_columns =
       ",contact_pairs,contact_impulses,impact_zones,contact_unresolved,contact_ms,response_iterations,response_cg_iterations,"
-      "response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy,contact_relinearisations";
+      "response_factorizations,contact_newton_iterations,contact_active_pairs,contact_energy,contact_relinearisations,"
+      "step_ms,first_solve_ms,newton_solve_ms,barrier_ms,line_search_ms,candidates_ms,failsafe_ms";
   const std::string header_with = first_line(out() / "touch" / "stats.csv");
   const std::string header_without = first_line(out() / "free" / "stats.csv");
   EXPECT_EQ(header_with.size() >= contact_columns.size() &&
@@ -609,7 +668,9 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
   ASSERT_TRUE(sa.contains("contact")) << sa.dump();
   for (const char* key : {"pairs_tested", "impulses", "impact_zones", "unresolved_pairs", "seconds",
                           "broad_phase_seconds", "narrow_phase_seconds", "response_seconds", "response_iterations",
-                          "response_cg_iterations", "response_factorizations"})
+                          "response_cg_iterations", "response_factorizations", "first_solve_seconds", "newton_solve_seconds",
+                          "line_search_seconds", "candidates_seconds", "failsafe_seconds", "contact_steps",
+                          "contact_step_seconds", "free_steps", "free_step_seconds"})
     EXPECT_TRUE(sa["contact"].contains(key)) << key << ": " << sa.dump();
   EXPECT_GT(sa["contact"]["pairs_tested"].get<long long>(), 0);  // the cloth starts within the thickness
   EXPECT_FALSE(sb.contains("contact")) << sb.dump();
