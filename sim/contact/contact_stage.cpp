@@ -19,8 +19,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <iomanip>
 #include <mutex>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 
 namespace clothsim {
@@ -118,6 +120,37 @@ struct ContactStage::Impl {
 
   // --- Positions -------------------------------------------------------------------------------
   bool end_points_current = false;  // p1 matches the velocities (no impulse since it was computed)
+  bool start_checked = false;       // the first step's start was checked against the planes
+
+  // A cloth that starts on the wrong side of a plane cannot be brought back by contact (the barrier
+  // pushes a pair apart along the side it is on, and every move across the plane is a crossing):
+  // it is an error in the scene, reported at the first step with the plane and how deep the cloth
+  // is behind it. (A plane turned into a sheet, found by fuzzing, ran its first step for minutes
+  // and grew to 2 GB.) Round-off below a hundredth of the thickness is let through.
+  void check_start_against_planes(double t) const {
+    for (size_t k = 0; k < obstacles.size(); ++k) {
+      const Obstacle& o = obstacles[k];
+      if (o.shape != Obstacle::Shape::plane) continue;
+      Eigen::Vector3d q, n;
+      plane_at(o, t, q, n);
+      Eigen::Index deepest = -1;
+      double depth = 0.01 * settings.thickness;
+      for (Eigen::Index p = 0; p < positions.p0.rows(); ++p) {
+        const double behind = -n.dot(positions.p0.row(p).transpose() - q);
+        if (behind > depth) depth = behind, deepest = p;
+      }
+      if (deepest < 0) continue;
+      Eigen::Index count = 0;
+      for (Eigen::Index p = 0; p < positions.p0.rows(); ++p) count += n.dot(positions.p0.row(p).transpose() - q) < 0 ? 1 : 0;
+      std::ostringstream what;
+      what << std::setprecision(4) << "obstacles[" << k << "] \"" << o.name << "\": the cloth starts behind this plane, up to "
+           << depth << " m deep (" << count << " of its " << positions.p0.rows() << " collision-surface points, the deepest at ("
+           << positions.p0(deepest, 0) << ", " << positions.p0(deepest, 1) << ", " << positions.p0(deepest, 2)
+           << ")); contact cannot bring it back: move the cloth or the plane so that the cloth starts on the side its normal "
+              "points to";
+      throw std::runtime_error(what.str());
+    }
+  }
 
   void update_end_points(const Eigen::VectorXd& v) {
     if (end_points_current) return;
@@ -313,6 +346,8 @@ struct ContactStage::Impl {
     // (Through the point rows where they are in node form: the crushed sleeve's start points took
     // a twentieth of its contact time through the control net.)
     positions.p0 = surf.points_through_rows(x);
+    if (!start_checked) check_start_against_planes(t);
+    start_checked = true;
     end_points_current = false;
     const bool placed = obstacles_static && positions.o0.rows() == static_cast<Eigen::Index>(obs.obstacle_of_vertex.size());
     if (!placed) positions.obstacle_boxes_current = false;

@@ -19,6 +19,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -563,6 +564,29 @@ TEST_F(ContactKeysCli, ResponseFiguresSumTheirColumns) {
   const RunResult b = run_scene(press("press_barrier", "barrier"), "--no-render");
   ASSERT_EQ(b.exit_code, 0) << b.err;
   expect_sums("press_barrier", {{"contact_newton_iterations", "newton_iterations"}});
+}
+
+// A cloth that starts behind a plane (a ground turned into a wall through the sheet, as fuzzing
+// found it: the first step ran for minutes and grew to 2 GB) stops at the first step with an error
+// naming the obstacle and how deep the cloth is behind it; the run's summary says it failed.
+TEST_F(ContactKeysCli, ClothStartingBehindAPlaneIsAnError) {
+  const fs::path scene = write("behind.json", R"({"name": "behind", "analysis": "dynamic",
+      "mesh": {"primitive": "grid", "size": [0.6, 0.6], "divisions": [12, 12],
+               "rotate": {"axis": [1, 0, 0], "angle_deg": -90}, "translate": [0, 0.25, 0]},
+      "material": {"preset": "cotton"},
+      "loads": {"gravity": [0, -9.81, 0]},
+      "time": {"dt": 0.002, "end": 0.1},
+      "collision": {"self": true, "thickness": 0.002},
+      "obstacles": [{"name": "ground", "primitive": "plane", "point": [0, 0, 0], "normal": [0, 1, 1e6]}]})");
+  const auto start = std::chrono::steady_clock::now();
+  const RunResult r = run_scene(scene, "--no-render");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_LT(seconds, 30.0);
+  EXPECT_TRUE(contains(r.err, "obstacles[0] \"ground\": the cloth starts behind this plane, up to 0.3")) << r.err;
+  EXPECT_TRUE(contains(r.err, "step 1 ")) << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(clothsim::testing::read_file_bytes(out() / "behind" / "summary.json"));
+  EXPECT_EQ(summary["status"], "failed") << summary.dump();
 }
 
 // Where a step's time goes is booked apart (issue 44): per stats.csv row the parts (the first
