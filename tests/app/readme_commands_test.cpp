@@ -199,6 +199,13 @@ const std::map<std::string, Form>& forms() {
          "{python} {src}/scripts/scaling.py plot {tmp}/scaling.png {tmp}/scaling.csv && test -s {tmp}/scaling.png"},
         "{python} {src}/scripts/scaling.py --help",
         "python:matplotlib"}},
+      // Two steps of the garment drop on a coarse T-shirt, clothsim alone (Blender's side:
+      // GarmentDrop.AgainstBlender, where Blender is installed); its row of the table.
+      {"bench/garment_drop.py",
+       {{"{python} {src}/bench/garment_drop.py --bin {clothsim} --checker {build}/tools/check_intersections --no-blender "
+         "--edge-length 0.06 --end 0.01 --rounds 1 --work {tmp}/garment | grep -q '| clothsim | 5 |'"},
+        "{python} {src}/bench/garment_drop.py --help",
+        ""}},
       // Two labels on the same build, one small scene, two steps; the before/after table.
       {"scripts/scene_times.py run --csv OUT.csv --bin LABEL=CLOTHSIM[@SCENES_DIR]",
        {{"{python} {src}/scripts/scene_times.py run --csv {tmp}/times.csv --bin a={clothsim} --bin b={clothsim}@{src}/scenes "
