@@ -506,17 +506,7 @@ StepStats ImplicitEuler::step(DynamicState& state) {
       continue;
     }
     if (!potential_acted_ || k + 1 >= settings_.newton_iterations + kMaxRelinearisations) break;
-    t0 = std::chrono::steady_clock::now();
-    end_positions(x, v_next, target, x_lin, u_lin);
-    try {
-      update_terms(x_lin, u_lin, t_next);
-    } catch (const std::exception& e) {
-      throw SimulationError(step_number, t_next, e.what());
-    }
-    stats.update_ms += ms_since(t0);
-    double turn = 0.0;
-    for (const ForceTerm* term : all_) turn = std::max(turn, term->frame_turn());
-    if (turn <= settings_.rotation_tolerance) break;
+    if (!turned(v_next)) break;
     relinearised = true;
     ++stats.contact.relinearisations;
   }
