@@ -199,7 +199,21 @@ std::string summary_json(const Scene& scene, const RunTotals& totals, const Sett
                    {"membrane_strain_start", settle.strain_start},
                    {"membrane_strain_end", settle.strain_end},
                    {"seam_gap_start", settle.gap_start},
-                   {"seam_gap_end", settle.gap_end}};
+                   {"seam_gap_end", settle.gap_end},
+                   // Its steps' time, booked as the run's (the "contact" keys below).
+                   {"step_seconds", settle.step_ms / 1000.0},
+                   {"solver_iterations", settle.solver_iterations},
+                   {"factorizations", settle.factorizations},
+                   {"newton_iterations", settle.contact.newton_iterations},
+                   {"relinearisations", settle.contact.relinearisations},
+                   {"first_solve_seconds", settle.contact.first_solve_ms / 1000.0},
+                   {"newton_solve_seconds", settle.contact.newton_solve_ms / 1000.0},
+                   {"barrier_seconds", (settle.contact.potential_ms - settle.contact.line_search_ms - settle.contact.candidates_ms) / 1000.0},
+                   {"line_search_seconds", settle.contact.line_search_ms / 1000.0},
+                   {"candidates_seconds", settle.contact.candidates_ms / 1000.0},
+                   {"failsafe_seconds", settle.contact.failsafe_ms / 1000.0},
+                   {"impulses", settle.contact.impulses},
+                   {"unresolved_pairs", settle.contact.unresolved}};
   if (scene.problem.has_contact())
     j["contact"] = {{"pairs_tested", totals.contact.pairs_tested},
                     {"impulses", totals.contact.impulses},
@@ -575,6 +589,16 @@ int run_dynamic_scene(const Scene& scene, const fs::path& out_root, const Dynami
              format_short(100 * settle.strain_start) + " % at the start, " + format_short(100 * settle.strain_end) +
              " % at the end; largest seam gap (a control edge longer than in the pattern) " +
              format_short(settle.gap_start) + " m at the start, " + format_short(settle.gap_end) + " m at the end");
+    if (scene.problem.has_contact()) {
+      const ContactCounters& c = settle.contact;
+      log_line("settle: " + format_short(settle.step_ms / 1000.0) + " s in its steps, " +
+               std::to_string(c.newton_iterations) + " Newton solves (" + std::to_string(c.relinearisations) +
+               " re-linearised); first solves " + format_short(c.first_solve_ms / 1000.0) + " s, Newton's further solves " +
+               format_short(c.newton_solve_ms / 1000.0) + " s, barrier " +
+               format_short((c.potential_ms - c.line_search_ms - c.candidates_ms) / 1000.0) + " s, CCD line search " +
+               format_short(c.line_search_ms / 1000.0) + " s, candidate search " + format_short(c.candidates_ms / 1000.0) +
+               " s, fail-safe " + format_short(c.failsafe_ms / 1000.0) + " s (" + std::to_string(c.impulses) + " impulses)");
+    }
   }
   // The renderer and the refinement operator, also before any file is written.
   std::unique_ptr<LimitSurfaceDrawer> drawer;

@@ -40,6 +40,11 @@ struct SettleReport {
   // edge is, at most — an open seam is a band of edges stretched across the gap [m]; 0 without
   // texture coordinates.
   double gap_start = 0.0, gap_end = 0.0;
+  // Where its time went: the settle's steps as a run's are booked (StepStats), summed [ms], and
+  // their linear solver's iterations and factorisations.
+  double step_ms = 0.0;
+  long long solver_iterations = 0, factorizations = 0;
+  ContactCounters contact;
 };
 
 class Simulator {

@@ -48,5 +48,31 @@ TEST_F(PatternCli, ObjFramesCarryThePatternCoordinates) {
   }
 }
 
+// The settle's steps are booked as a run's (issue 44): summary.json's "settle" holds their time,
+// Newton solves and parts, the parts adding up to at most the steps' time; the log says it.
+TEST_F(PatternCli, TheSettleReportsWhereItsTimeWent) {
+  std::string text = kSkirt;
+  text.replace(text.find("LEVEL"), 5, "0");
+  text.replace(text.find(R"("settle")"), 0, R"("collision": {"self": true, "thickness": 0.002}, )");
+  const auto scene = write("skirt.json", text);
+  const testing::CliResult r = run(q(scene) + " --no-render --out " + q(dir_ / "out"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto settle = nlohmann::json::parse(testing::read_file_bytes(dir_ / "out/skirt/summary.json"))["settle"];
+  EXPECT_EQ(settle["steps"], 5);
+  EXPECT_GE(settle["newton_iterations"].get<long long>(), 5) << settle.dump();  // (a potential solve per step at least)
+  const double steps = settle["step_seconds"].get<double>();
+  EXPECT_GT(steps, 0.0);
+  double parts = 0.0;
+  for (const char* key : {"first_solve_seconds", "newton_solve_seconds", "barrier_seconds", "line_search_seconds",
+                          "candidates_seconds", "failsafe_seconds"}) {
+    ASSERT_TRUE(settle.contains(key)) << key;
+    EXPECT_GE(settle[key].get<double>(), 0.0) << key;
+    parts += settle[key].get<double>();
+  }
+  EXPECT_LE(parts, steps * (1 + 1e-9));
+  EXPECT_GT(settle["first_solve_seconds"].get<double>(), 0.0);
+  EXPECT_NE(r.err.find("settle: "), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace clothsim
