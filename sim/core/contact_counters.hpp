@@ -32,6 +32,9 @@ struct ContactCounters {
   double contact_step_ms = 0.0;           // their whole time [ms]
   double free_step_ms = 0.0;              // the whole time of the other steps [ms]
 
+  // The barrier's own evaluations: potential_ms less its candidate search and line search [ms].
+  double barrier_evaluation_ms() const { return potential_ms - line_search_ms - candidates_ms; }
+
   ContactCounters& operator+=(const ContactCounters& o) {
     pairs_tested += o.pairs_tested;
     impulses += o.impulses;

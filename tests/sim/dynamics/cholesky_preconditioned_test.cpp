@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 namespace clothsim {
 namespace {
 
@@ -63,6 +65,32 @@ TEST(CholeskyPreconditioned, MatchesTheDirectSolveAndReusesTheFactor) {
   EXPECT_GE(factorizations, 2);
   EXPECT_LT(factorizations, 3 * direct.num_steps() / 4);
   EXPECT_GT(iterations, direct.num_steps());  // a stale factor is not exact
+}
+
+// A run whose conjugate-gradient solves fail goes on: each failed solve is finished by the direct
+// solver (LinearSolver's fallback), the step says so in StepStats (direct_fallbacks and the
+// reason), and the motion is the one CHOLMOD computes when it solves every step.
+TEST(SolverFallback, FailedPcgStepsAreSolvedDirectlyAndTheRunGoesOn) {
+  Problem p = tipped_sleeve();
+  p.time.end = 0.05;
+  p.solver.type = LinearSolverType::cholmod;
+  Simulator direct(p);
+  // One iteration towards 1e-12 cannot converge: every step's solve falls back.
+  p.solver.type = LinearSolverType::pcg;
+  p.solver.preconditioner = PreconditionerType::cholesky;
+  p.solver.tolerance = 1e-12;
+  p.solver.max_iterations = 1;
+  Simulator pcg(p);
+  for (int i = 0; i < direct.num_steps(); ++i) {
+    direct.step();
+    const StepStats s = pcg.step();
+    EXPECT_EQ(s.direct_fallbacks, 1) << "step " << s.step;
+    EXPECT_NE(s.direct_fallback_reason.find("the conjugate gradient solver did not converge"), std::string::npos)
+        << s.direct_fallback_reason;
+  }
+  const double moved = (direct.state().positions() - p.mesh.vertices).cwiseAbs().maxCoeff();
+  ASSERT_GT(moved, 1e-3);  // the rim has tipped the sleeve by a few millimetres
+  EXPECT_LE((pcg.state().positions() - direct.state().positions()).cwiseAbs().maxCoeff(), 1e-10 * moved);
 }
 
 }  // namespace

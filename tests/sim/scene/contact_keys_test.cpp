@@ -692,7 +692,7 @@ TEST_F(ContactKeysCli, ContactOutputsOnlyWithContact) {
   ASSERT_TRUE(sa.contains("contact")) << sa.dump();
   for (const char* key : {"pairs_tested", "impulses", "impact_zones", "unresolved_pairs", "seconds",
                           "broad_phase_seconds", "narrow_phase_seconds", "response_seconds", "response_iterations",
-                          "response_cg_iterations", "response_factorizations", "first_solve_seconds", "newton_solve_seconds",
+                          "response_cg_iterations", "response_factorizations", "barrier_evaluation_seconds", "first_solve_seconds", "newton_solve_seconds",
                           "line_search_seconds", "candidates_seconds", "failsafe_seconds", "contact_steps",
                           "contact_step_seconds", "free_steps", "free_step_seconds"})
     EXPECT_TRUE(sa["contact"].contains(key)) << key << ": " << sa.dump();
