@@ -464,8 +464,8 @@ TEST(ContactEnergy, DroppedClothNeverGainsMechanicalEnergy) {
   // allowed is the contact solver's error, which must go to zero with its tolerance
   // (collision.tolerance, in velocity, a fraction of the thickness per step). The barrier's energy
   // is part of the mechanical energy (a potential energy of the positions). Measured with the
-  // barrier: 3.4e-21 J at both tolerances (round-off; its Newton iterations stop at 1 % of the
-  // tolerance); with the constraints method 7.3e-12 J at the default 1e-3 and 8.5e-14 J at 1e-5,
+  // barrier: 3.4e-21 J at both tolerances (round-off; its Newton iterations stop on the step solved
+  // for, at the tolerance, or at the linear solver's floor); with the constraints method 7.3e-12 J at the default 1e-3 and 8.5e-14 J at 1e-5,
   // against a drop energy of 3.6e-5 J. Bounds: 1e-6 of the drop energy at 1e-3, 1e-8 at 1e-5.
   for (const auto& [tolerance, bound] : {std::pair{1e-3, 1e-6}, std::pair{1e-5, 1e-8}}) {
     const DropRun run = drop_on_ground(0.5, tolerance);
